@@ -1,0 +1,12 @@
+// The derived structure of a scene as JSON (`flatmarch inspect`, DESIGN.md section 5).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "scene/scene.hpp"
+
+namespace flatmarch {
+
+nlohmann::json inspect(const Scene& scene);
+
+}  // namespace flatmarch

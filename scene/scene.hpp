@@ -1,0 +1,161 @@
+// The scene model of DESIGN.md section 1: polygons whose edges are glued in pairs (or act as
+// mirrors or walls), thickened into rooms, with objects, a camera and a look. A Scene is only
+// ever built by load_scene/parse_scene, which validate every rule and derive everything that
+// can be derived (gluing maps, edge table, vertex classes, topology); nothing derived is read
+// from the file.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scene/geometry.hpp"
+
+namespace flatmarch {
+
+struct EdgeRef {
+  int polygon = 0;
+  int edge = 0;
+  friend bool operator==(const EdgeRef&, const EdgeRef&) = default;
+};
+
+// How a gluing is written in the scene file.
+enum class GluingMap { isometry, reflection, similarity, matrix };
+
+// What the derived map is (DESIGN.md: translation, half-translation, rotation; plus the
+// variants' kinds).
+enum class GluingType { translation, half_translation, rotation, reflection, similarity, affine };
+
+struct Gluing {
+  EdgeRef a, b;
+  GluingMap map = GluingMap::isometry;
+  Affine2 g;  // carries the outside of a's polygon beyond a into b's polygon
+  GluingType type = GluingType::translation;
+};
+
+enum class EdgeKind { glued, mirror, wall };
+
+// One edge of a polygon, with everything a ray crossing it needs.
+struct Edge {
+  EdgeKind kind = EdgeKind::mirror;
+  int gluing = -1;   // index into Scene::gluings when glued
+  EdgeRef to;        // destination edge when glued
+  Affine2 map;       // this polygon's coordinates -> to.polygon's coordinates when glued
+  Vec2 normal{0.0};  // outward unit normal
+  double length = 0.0;
+};
+
+struct Polygon {
+  std::vector<Vec2> vertices;  // counterclockwise
+  std::vector<Edge> edges;     // edge i runs from vertex i to vertex i+1 (mod n)
+
+  int size() const { return static_cast<int>(vertices.size()); }
+  Vec2 vertex(int i) const { return vertices[static_cast<size_t>(((i % size()) + size()) % size())]; }
+  double area() const;
+  Vec2 centroid() const;
+  // Strictly inside, at least `margin` away from every edge.
+  bool contains(Vec2 p, double margin = 0.0) const;
+  double distance_to_boundary(Vec2 p) const;
+  // Interior angle at vertex i, in (0, 2pi).
+  double corner_angle(int i) const;
+};
+
+enum class ObjectType { hollow_cube, sphere, box, cylinder };
+
+struct Object {
+  ObjectType type = ObjectType::sphere;
+  int polygon = 0;
+  Vec3 center{0.0};
+  double size = 0.0;    // hollow_cube: half-size of the cube
+  double hole = 0.0;    // hollow_cube: radius of the removed sphere
+  double radius = 0.0;  // sphere, cylinder
+  Vec3 half{0.0};       // box half-extents
+  double z0 = 0.0, z1 = 0.0;  // cylinder extent in z
+  std::optional<Vec3> color;
+
+  // Radius of the horizontal circle around the center that holds the object.
+  double footprint_radius() const;
+  // Lowest and highest z of the object.
+  double z_min() const;
+  double z_max() const;
+};
+
+// A vertical cylinder drawn around a vertex class ("singularities"/"vertices" in the scene):
+// in each polygon it is the disk sector around each corner of the class. Its object index
+// (hit AOV, traces) is Scene::objects.size() + its position in Scene::markers.
+struct Marker {
+  int vertex_class = 0;
+  double radius = 0.0;
+};
+
+struct Corner {
+  int polygon = 0;
+  int vertex = 0;
+};
+
+struct VertexClass {
+  std::vector<Corner> corners;
+  double cone_angle = 0.0;  // sum of the corner angles
+  bool boundary = false;    // touches a mirror or wall edge
+  // Interior class: cone angle != 2pi. Boundary class: != pi (the cone angle 2x of the double
+  // of the surface along its boundary differs from 2pi), so a straight boundary point is regular.
+  bool singular = false;
+};
+
+struct Topology {
+  int components = 1;
+  int euler_characteristic = 0;
+  bool orientable = true;
+  int boundary_components = 0;
+  // Orientable: the number of handles; non-orientable: the number of cross-caps. Unset when
+  // the scene has more than one component.
+  std::optional<int> genus;
+};
+
+struct Camera {
+  int polygon = 0;
+  Vec3 position{0.0};
+  double yaw_deg = 0.0;
+  double pitch_deg = 0.0;
+  double fov_deg = 75.0;
+};
+
+struct Look {
+  double wall_tint = 0.05;
+  Vec3 fog{0.5, 0.6, 0.7};
+  Vec3 background{1.0, 1.0, 1.0};
+};
+
+struct Scene {
+  std::string name;
+  std::string description;
+  std::vector<Polygon> polygons;
+  std::vector<Gluing> gluings;
+  double height = 2.0;
+  std::optional<double> period;  // translation prism: z modulo period, nothing escapes
+  bool floor = false;
+  std::vector<Object> objects;
+  std::vector<Marker> markers;
+  Camera camera;
+  Look look;
+
+  // Derived.
+  std::vector<VertexClass> vertex_classes;
+  std::vector<std::vector<int>> corner_class;  // [polygon][vertex] -> index in vertex_classes
+  Topology topology;
+  double scale = 1.0;  // largest absolute vertex coordinate, at least 1: the unit of tolerances
+
+  const Edge& edge(EdgeRef e) const {
+    return polygons[static_cast<size_t>(e.polygon)].edges[static_cast<size_t>(e.edge)];
+  }
+  // Index of the marker drawn at corner (p, v), or -1.
+  int marker_at(int polygon, int vertex) const;
+  // Whether z lies in the band of the walls (always in a translation prism).
+  bool in_band(double z) const { return period || (z >= 0.0 && z <= height); }
+};
+
+const char* to_string(GluingType t);
+const char* to_string(EdgeKind k);
+const char* to_string(ObjectType t);
+
+}  // namespace flatmarch
