@@ -5,10 +5,10 @@ namespace flatmarch {
 namespace {
 
 // Adding 0.0 prints -0.0 as 0.
-nlohmann::json point(Vec2 p) { return {p.x + 0.0, p.y + 0.0}; }
-nlohmann::json point(Vec3 p) { return {p.x, p.y, p.z}; }
+nlohmann::ordered_json point(Vec2 p) { return {p.x + 0.0, p.y + 0.0}; }
+nlohmann::ordered_json point(Vec3 p) { return {p.x, p.y, p.z}; }
 
-nlohmann::json map_json(const Affine2& m) {
+nlohmann::ordered_json map_json(const Affine2& m) {
   // Row-major, as scene files write matrices.
   return {{"linear", {point(Vec2(m.linear[0][0], m.linear[1][0])), point(Vec2(m.linear[0][1], m.linear[1][1]))}},
           {"translation", point(m.translation)}};
@@ -26,15 +26,15 @@ const char* map_name(GluingMap m) {
 
 }  // namespace
 
-nlohmann::json inspect(const Scene& scene) {
-  nlohmann::json out;
+nlohmann::ordered_json inspect(const Scene& scene) {
+  nlohmann::ordered_json out;
   out["scene"] = scene.name;
 
-  auto& polygons = out["polygons"] = nlohmann::json::array();
-  auto& edges = out["edges"] = nlohmann::json::array();
+  auto& polygons = out["polygons"] = nlohmann::ordered_json::array();
+  auto& edges = out["edges"] = nlohmann::ordered_json::array();
   for (size_t p = 0; p < scene.polygons.size(); ++p) {
     const Polygon& polygon = scene.polygons[p];
-    nlohmann::json vertices = nlohmann::json::array(), angles = nlohmann::json::array();
+    nlohmann::ordered_json vertices = nlohmann::ordered_json::array(), angles = nlohmann::ordered_json::array();
     for (int v = 0; v < polygon.size(); ++v) {
       vertices.push_back(point(polygon.vertex(v)));
       angles.push_back(polygon.corner_angle(v));
@@ -42,7 +42,7 @@ nlohmann::json inspect(const Scene& scene) {
     polygons.push_back({{"vertices", vertices}, {"corner_angles", angles}, {"area", polygon.area()}});
     for (int i = 0; i < polygon.size(); ++i) {
       const Edge& e = polygon.edges[static_cast<size_t>(i)];
-      nlohmann::json edge = {{"polygon", p},
+      nlohmann::ordered_json edge = {{"polygon", p},
                              {"edge", i},
                              {"from", point(polygon.vertex(i))},
                              {"to", point(polygon.vertex(i + 1))},
@@ -59,16 +59,16 @@ nlohmann::json inspect(const Scene& scene) {
     }
   }
 
-  auto& gluings = out["gluings"] = nlohmann::json::array();
+  auto& gluings = out["gluings"] = nlohmann::ordered_json::array();
   for (const Gluing& g : scene.gluings)
     gluings.push_back({{"edges", {{g.a.polygon, g.a.edge}, {g.b.polygon, g.b.edge}}},
                        {"written_as", map_name(g.map)},
                        {"type", to_string(g.type)},
                        {"map", map_json(g.g)}});
 
-  auto& classes = out["vertex_classes"] = nlohmann::json::array();
+  auto& classes = out["vertex_classes"] = nlohmann::ordered_json::array();
   for (const VertexClass& vc : scene.vertex_classes) {
-    nlohmann::json corners = nlohmann::json::array();
+    nlohmann::ordered_json corners = nlohmann::ordered_json::array();
     for (const Corner& c : vc.corners) corners.push_back({c.polygon, c.vertex});
     classes.push_back({{"corners", corners},
                        {"cone_angle", vc.cone_angle},
@@ -80,19 +80,19 @@ nlohmann::json inspect(const Scene& scene) {
   const Topology& t = scene.topology;
   out["euler_characteristic"] = t.euler_characteristic;
   out["orientable"] = t.orientable;
-  out["genus"] = t.genus ? nlohmann::json(*t.genus) : nlohmann::json();
+  out["genus"] = t.genus ? nlohmann::ordered_json(*t.genus) : nlohmann::ordered_json();
   out["components"] = t.components;
   out["boundary_components"] = t.boundary_components;
 
   out["height"] = scene.height;
-  out["period"] = scene.period ? nlohmann::json(*scene.period) : nlohmann::json();
+  out["period"] = scene.period ? nlohmann::ordered_json(*scene.period) : nlohmann::ordered_json();
   out["floor"] = scene.floor;
-  auto& objects = out["objects"] = nlohmann::json::array();
+  auto& objects = out["objects"] = nlohmann::ordered_json::array();
   for (size_t k = 0; k < scene.objects.size(); ++k) {
     const Object& o = scene.objects[k];
     objects.push_back({{"index", k}, {"type", to_string(o.type)}, {"polygon", o.polygon}, {"center", point(o.center)}});
   }
-  auto& markers = out["markers"] = nlohmann::json::array();
+  auto& markers = out["markers"] = nlohmann::ordered_json::array();
   for (size_t m = 0; m < scene.markers.size(); ++m)
     markers.push_back({{"index", scene.objects.size() + m},
                        {"vertex_class", scene.markers[m].vertex_class},

@@ -7,6 +7,6 @@
 
 namespace flatmarch {
 
-nlohmann::json inspect(const Scene& scene);
+nlohmann::ordered_json inspect(const Scene& scene);
 
 }  // namespace flatmarch

@@ -1,0 +1,102 @@
+// The interface every backend implements (oracle first; the kernels' backends later), the march
+// parameters of DESIGN.md section 3 and the outputs of section 4.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kernels/hit.hpp"
+#include "scene/scene.hpp"
+
+namespace flatmarch {
+
+enum class Method { sphere, relaxed, analytic, oracle };
+enum class Precision { f32, f64 };
+
+const char* to_string(Method m);
+std::optional<Method> parse_method(const std::string& name);
+
+struct MarchParams {
+  Method method = Method::sphere;
+  double eps = 1e-4;
+  double offset = 2e-4;
+  int max_steps = 1024;
+  double max_distance = 100.0;
+  double omega = 1.6;
+  Precision precision = Precision::f32;
+};
+
+// One ray, in the coordinates of `polygon` (ignored when `from` lies outside every wall band).
+struct Ray {
+  int polygon = 0;
+  Vec3 from{0.0};
+  Vec3 dir{1.0, 0.0, 0.0};
+};
+
+// Events of a transport trace. `enter` (a ray from a camera outside the band entering a room)
+// and `miss` (never entering one) extend DESIGN.md's list.
+enum class EventKind { gluing, mirror, enter, object, wall, floor, escape, vertex, max_steps, max_distance, miss };
+const char* to_string(EventKind k);
+std::optional<EventKind> parse_event_kind(const std::string& name);
+bool is_final(EventKind k);
+int hit_code(EventKind final_kind, int object);  // the `hit` AOV value of a final event
+
+struct Event {
+  EventKind kind = EventKind::gluing;
+  int polygon = 0;
+  int edge = -1;        // gluing, mirror, wall
+  int to_polygon = -1;  // gluing
+  int to_edge = -1;     // gluing
+  int object = -1;      // object (index in the hit AOV's numbering)
+  double t = 0.0;
+  Vec3 at{0.0};  // in the coordinates of `polygon`, before any map
+};
+
+struct Trace {
+  std::vector<Event> events;  // the last one is final unless the trace was cut at max_events
+  int steps = 0;
+};
+
+// A rendered frame: colour and the AOVs, row-major with row 0 at the top.
+struct Frame {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // linear colour, 3 floats a pixel
+  std::vector<float> steps, crossings, hit, t;
+
+  Frame() = default;
+  Frame(int w, int h);
+  size_t pixel(int i, int j) const { return static_cast<size_t>(j) * static_cast<size_t>(width) + static_cast<size_t>(i); }
+};
+
+struct Availability {
+  bool available = true;
+  std::string reason;  // why not, when unavailable
+};
+
+// Called now and then during long work with the fraction done, in [0, 1].
+using Progress = std::function<void(double)>;
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual std::string name() const = 0;
+  virtual std::string description() const = 0;
+  virtual Availability availability() const = 0;
+  // Methods this backend runs; `oracle` runs only Method::oracle.
+  virtual std::vector<Method> methods() const = 0;
+
+  virtual Frame render(const Scene& scene, const Camera& camera, int width, int height,
+                       const MarchParams& params, const Progress& progress) const = 0;
+  // Follows one ray, recording at most `max_events` events.
+  virtual Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+                      int max_events) const = 0;
+};
+
+// All backends this build knows, available here or not.
+const std::vector<std::unique_ptr<Backend>>& backends();
+const Backend* find_backend(const std::string& name);
+
+}  // namespace flatmarch

@@ -1,0 +1,314 @@
+#include "backends/oracle/oracle.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+
+#include "backends/oracle/intersect.hpp"
+#include "kernels/camera.hpp"
+#include "kernels/shade.hpp"
+
+namespace flatmarch {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Where a ray inside a room leaves it horizontally: the first edge it crosses outward.
+struct Exit {
+  double t = kInf;
+  int edge = -1;
+};
+
+Exit find_exit(const Polygon& polygon, Vec2 o, Vec2 dh) {
+  Exit exit;
+  if (dh.x == 0.0 && dh.y == 0.0) return exit;
+  for (int i = 0; i < polygon.size(); ++i) {
+    const Edge& edge = polygon.edges[static_cast<size_t>(i)];
+    if (glm::dot(dh, edge.normal) <= 0.0) continue;  // the ray cannot leave through this edge
+    const Vec2 a = polygon.vertex(i), ab = polygon.vertex(i + 1) - a;
+    const double denom = cross(dh, ab);
+    const double s = cross(a - o, ab) / denom;  // where the ray meets the edge's line
+    const double u = cross(a - o, dh) / denom;  // where along the edge, in [0, 1] on it
+    const double u_tol = kVertexTolerance / edge.length;
+    if (u < -u_tol || u > 1.0 + u_tol || s < -kVertexTolerance) continue;
+    if (s < exit.t) exit = {std::max(s, 0.0), i};
+  }
+  return exit;
+}
+
+// The first vertex of the polygon the ray meets (passes within kVertexTolerance of) for
+// t in (0, limit].
+struct VertexMeet {
+  double t = kInf;
+  int vertex = -1;
+};
+
+VertexMeet find_vertex(const Polygon& polygon, Vec2 o, Vec2 dh, double limit) {
+  VertexMeet meet;
+  const double dh2 = glm::dot(dh, dh);
+  if (dh2 == 0.0) return meet;
+  const double dh_len = std::sqrt(dh2);
+  for (int k = 0; k < polygon.size(); ++k) {
+    const Vec2 w = polygon.vertex(k) - o;
+    const double s = glm::dot(w, dh) / dh2;
+    if (s <= 0.0 || s > limit + kVertexTolerance / dh_len || s >= meet.t) continue;
+    if (std::abs(cross(w, dh)) / dh_len <= kVertexTolerance) meet = {s, k};
+  }
+  return meet;
+}
+
+struct ObjectMeet {
+  double t = kInf;
+  int index = -1;
+  Vec3 normal{0.0};
+};
+
+// The first object or vertex marker of the room hit for t in [0, limit].
+ObjectMeet find_object(const Scene& scene, int p, Vec3 o, Vec3 d, double limit) {
+  ObjectMeet meet;
+  const auto consider = [&](const std::optional<SolidHit>& hit, int index) {
+    if (hit && hit->t < meet.t) meet = {hit->t, index, hit->normal};
+  };
+  for (size_t k = 0; k < scene.objects.size(); ++k)
+    if (scene.objects[k].polygon == p)
+      consider(intersect(scene.objects[k], o, d, 0.0, std::min(limit, meet.t)), static_cast<int>(k));
+  if (!scene.markers.empty()) {
+    const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
+    const double top = scene.period ? *scene.period : scene.height;
+    for (int v = 0; v < polygon.size(); ++v) {
+      const int m = scene.marker_at(p, v);
+      if (m < 0) continue;
+      consider(intersect_cylinder(polygon.vertex(v), scene.markers[static_cast<size_t>(m)].radius, 0.0, top, o,
+                                  d, 0.0, std::min(limit, meet.t)),
+               static_cast<int>(scene.objects.size()) + m);
+    }
+  }
+  return meet;
+}
+
+double wrap(double z, double period) { return z - period * std::floor(z / period); }
+
+class Tracer {
+ public:
+  Tracer(const Scene& scene, const MarchParams& params, const OracleOptions& options, OracleResult& out)
+      : scene_(scene), params_(params), options_(options), out_(out) {}
+
+  void run(const Ray& ray) {
+    p_ = ray.polygon;
+    o_ = ray.from;
+    d_ = glm::normalize(ray.dir);
+    if (scene_.period) o_.z = wrap(o_.z, *scene_.period);
+    if (!scene_.in_band(o_.z) && !enter_from_outside()) return;
+    while (out_.end.steps < params_.max_steps) {
+      ++out_.end.steps;
+      if (step()) return;
+    }
+    finish(EventKind::max_steps, kHitMaxSteps, 0.0, -1);
+  }
+
+ private:
+  // A camera above or below the band sees the rooms laid out as their coordinates place them.
+  // Returns false when the ray ended without entering one.
+  bool enter_from_outside() {
+    const bool above = o_.z > scene_.height;
+    if (above ? d_.z >= 0.0 : d_.z <= 0.0) {
+      miss(params_.max_distance);
+      return false;
+    }
+    const double s = ((above ? scene_.height : 0.0) - o_.z) / d_.z;
+    if (s > params_.max_distance) {
+      miss(params_.max_distance);
+      return false;
+    }
+    const Vec3 q = o_ + s * d_;
+    for (size_t k = 0; k < scene_.polygons.size(); ++k) {
+      if (!scene_.polygons[k].contains(Vec2(q))) continue;
+      p_ = static_cast<int>(k);
+      if (!above && scene_.floor) {  // the underside of the floor
+        finish(EventKind::floor, kHitFloor, s, -1, Vec3(0.0, 0.0, -1.0));
+        return false;
+      }
+      record({.kind = EventKind::enter, .polygon = p_, .t = s, .at = q});
+      add_path(q);
+      o_ = q;
+      t_ = s;
+      return true;
+    }
+    miss(s);
+    return false;
+  }
+
+  // One room segment; returns true when the ray has ended.
+  bool step() {
+    const Polygon& polygon = scene_.polygons[static_cast<size_t>(p_)];
+    const Vec2 o(o_), dh(d_);
+    const Exit exit = find_exit(polygon, o, dh);
+    const VertexMeet vertex = find_vertex(polygon, o, dh, exit.t);
+
+    double band = kInf;  // leaving the band: escape, floor, or a period wrap
+    const double top = scene_.period ? *scene_.period : scene_.height;
+    if (d_.z > 0.0) band = (top - o_.z) / d_.z;
+    if (d_.z < 0.0) band = -o_.z / d_.z;
+    const double remaining = params_.max_distance - t_;
+
+    const ObjectMeet object = find_object(scene_, p_, o_, d_, std::min({exit.t, vertex.t, band, remaining}));
+    // Ties go to the object, then the vertex, then the band, then the edge.
+    const double first = std::min({object.t, vertex.t, band, exit.t});
+    if (first > remaining) return finish(EventKind::max_distance, kHitMaxDistance, remaining, -1);
+    if (object.t == first) return finish(EventKind::object, object.index, object.t, -1, object.normal);
+    if (vertex.t == first) return finish(EventKind::vertex, kHitVertex, vertex.t, -1);
+    if (band == first) {
+      if (scene_.period) {  // z is taken modulo the period
+        advance(band);
+        o_.z = d_.z > 0.0 ? 0.0 : *scene_.period;
+        return false;
+      }
+      if (d_.z < 0.0 && scene_.floor) return finish(EventKind::floor, kHitFloor, band, -1, Vec3(0, 0, 1));
+      return finish(EventKind::escape, kHitEscape, band, -1);
+    }
+    if (exit.edge < 0) return finish(EventKind::vertex, kHitVertex, 0.0, -1);  // numerically cornered
+
+    const Edge& edge = polygon.edges[static_cast<size_t>(exit.edge)];
+    const Vec3 at = o_ + exit.t * d_;
+    switch (edge.kind) {
+      case EdgeKind::wall: return finish(EventKind::wall, kHitWall, exit.t, exit.edge, Vec3(-edge.normal, 0.0));
+      case EdgeKind::mirror: {
+        record({.kind = EventKind::mirror, .polygon = p_, .edge = exit.edge, .t = t_ + exit.t, .at = at});
+        advance(exit.t);
+        const Vec2 reflected = dh - 2.0 * glm::dot(dh, edge.normal) * edge.normal;
+        d_ = glm::normalize(Vec3(reflected, d_.z));
+        break;
+      }
+      case EdgeKind::glued: {
+        record({.kind = EventKind::gluing,
+                .polygon = p_,
+                .edge = exit.edge,
+                .to_polygon = edge.to.polygon,
+                .to_edge = edge.to.edge,
+                .t = t_ + exit.t,
+                .at = at});
+        advance(exit.t);
+        o_ = Vec3(edge.map.apply(Vec2(o_)), o_.z);
+        // Under a non-isometric map the horizontal direction follows the linear part and the
+        // 3D direction is renormalised (DESIGN.md section 1).
+        d_ = glm::normalize(Vec3(edge.map.apply_direction(Vec2(d_)), d_.z));
+        p_ = edge.to.polygon;
+        break;
+      }
+    }
+    ++out_.end.crossings;
+    return false;
+  }
+
+  void advance(double s) {
+    add_path(o_ + s * d_);
+    o_ += s * d_;
+    t_ += s;
+  }
+
+  bool finish(EventKind kind, int hit, double s, int edge, Vec3 normal = Vec3(0.0)) {
+    advance(s);
+    RayEnd& end = out_.end;
+    end.hit = hit;
+    end.t = t_;
+    end.polygon = p_;
+    end.at = o_;
+    end.normal = normal;
+    record({.kind = kind, .polygon = p_, .edge = edge, .object = hit >= 0 ? hit : -1, .t = t_, .at = o_});
+    return true;
+  }
+
+  void miss(double s) {
+    out_.end.hit = kHitMiss;
+    out_.end.t = s;
+    record({.kind = EventKind::miss, .polygon = -1, .t = s, .at = o_ + s * d_});
+  }
+
+  void record(const Event& e) {
+    if (static_cast<int>(out_.trace.events.size()) < options_.max_events) out_.trace.events.push_back(e);
+  }
+
+  void add_path(Vec3 to) {
+    if (options_.record_path) out_.path.push_back({p_, o_, to});
+  }
+
+  const Scene& scene_;
+  const MarchParams& params_;
+  const OracleOptions& options_;
+  OracleResult& out_;
+  int p_ = 0;
+  Vec3 o_{0.0}, d_{0.0};
+  double t_ = 0.0;
+};
+
+}  // namespace
+
+std::optional<std::string> ray_problem(const Scene& scene, const Ray& ray) {
+  const auto finite = [](Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  if (!finite(ray.from)) return "the ray's origin is not finite";
+  if (!finite(ray.dir) || glm::length(ray.dir) == 0.0) return "the ray's direction is zero or not finite";
+  if (ray.polygon < 0 || ray.polygon >= static_cast<int>(scene.polygons.size()))
+    return "polygon " + std::to_string(ray.polygon) + " does not exist (the scene has " +
+           std::to_string(scene.polygons.size()) + ")";
+  if (scene.in_band(ray.from.z) && !scene.polygons[static_cast<size_t>(ray.polygon)].contains(Vec2(ray.from))) {
+    std::ostringstream s;
+    s << "the origin (" << ray.from.x << ", " << ray.from.y << ", " << ray.from.z
+      << ") is within the wall band but not strictly inside polygon " << ray.polygon;
+    return s.str();
+  }
+  return std::nullopt;
+}
+
+OracleResult oracle_trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+                          const OracleOptions& options) {
+  OracleResult result;
+  Tracer(scene, params, options, result).run(ray);
+  result.trace.steps = result.end.steps;
+  return result;
+}
+
+Vec3 oracle_color(const Scene& scene, const RayEnd& end) {
+  const Vec3* color = nullptr;
+  if (end.hit >= 0 && end.hit < static_cast<int>(scene.objects.size()) && scene.objects[static_cast<size_t>(end.hit)].color)
+    color = &*scene.objects[static_cast<size_t>(end.hit)].color;
+  return shade<double>(end.hit, end.crossings, end.normal, end.at, color, scene.look.wall_tint, scene.look.fog,
+                       scene.look.background);
+}
+
+std::string OracleBackend::description() const {
+  return "exact analytic transport in float64 on the CPU: the ground truth";
+}
+
+Frame OracleBackend::render(const Scene& scene, const Camera& camera, int width, int height,
+                            const MarchParams& params, const Progress& progress) const {
+  Frame frame(width, height);
+  const CameraBasis<double> basis = camera_basis(camera.yaw_deg, camera.pitch_deg, camera.fov_deg, width, height);
+  constexpr int kRowsPerReport = 16;  // rows rendered in parallel between progress reports
+  for (int band = 0; band < height; band += kRowsPerReport) {
+    tbb::parallel_for(band, std::min(band + kRowsPerReport, height), [&](int j) {
+      for (int i = 0; i < width; ++i) {
+        const Ray ray{camera.polygon, camera.position, camera_ray(basis, i, j, width, height)};
+        const RayEnd end = oracle_trace(scene, ray, params).end;
+        const size_t px = frame.pixel(i, j);
+        const Vec3 c = oracle_color(scene, end);
+        for (int k = 0; k < 3; ++k) frame.rgb[3 * px + static_cast<size_t>(k)] = static_cast<float>(c[k]);
+        frame.steps[px] = static_cast<float>(end.steps);
+        frame.crossings[px] = static_cast<float>(end.crossings);
+        frame.hit[px] = static_cast<float>(end.hit);
+        frame.t[px] = static_cast<float>(end.t);
+      }
+    });
+    if (progress) progress(static_cast<double>(std::min(band + kRowsPerReport, height)) / height);
+  }
+  return frame;
+}
+
+Trace OracleBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params, int max_events) const {
+  return oracle_trace(scene, ray, params, {.max_events = max_events}).trace;
+}
+
+}  // namespace flatmarch

@@ -1,0 +1,43 @@
+#include <cstdio>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "backends/backend.hpp"
+#include "cli/commands.hpp"
+
+namespace flatmarch::cli {
+
+void add_backends(CLI::App& app) {
+  auto* cmd = app.add_subcommand("backends", "List the backends, whether each is available here, and why not.");
+  auto json = std::make_shared<bool>(false);
+  cmd->add_flag("--json", *json, "Print JSON instead of a table");
+  cmd->callback([json] {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& b : backends()) {
+      const Availability a = b->availability();
+      nlohmann::json methods = nlohmann::json::array();
+      for (Method m : b->methods()) methods.push_back(to_string(m));
+      list.push_back({{"name", b->name()},
+                      {"available", a.available},
+                      {"reason", a.reason},
+                      {"methods", methods},
+                      {"description", b->description()}});
+    }
+    if (*json) {
+      std::cout << list.dump(2) << "\n";
+      return;
+    }
+    std::printf("%-10s %-11s %-28s %s\n", "backend", "available", "methods", "description");
+    for (const auto& b : list) {
+      std::string methods;
+      for (const auto& m : b["methods"]) methods += (methods.empty() ? "" : ",") + m.get<std::string>();
+      const bool ok = b["available"].get<bool>();
+      std::printf("%-10s %-11s %-28s %s\n", b["name"].get<std::string>().c_str(), ok ? "yes" : "NO",
+                  methods.c_str(),
+                  (ok ? b["description"].get<std::string>() : "unavailable: " + b["reason"].get<std::string>()).c_str());
+    }
+  });
+}
+
+}  // namespace flatmarch::cli

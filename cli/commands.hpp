@@ -1,0 +1,13 @@
+// The subcommands of `flatmarch` (DESIGN.md section 5), one file each.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace flatmarch::cli {
+
+void add_inspect(CLI::App& app);
+void add_render(CLI::App& app);
+void add_trace(CLI::App& app);
+void add_backends(CLI::App& app);
+
+}  // namespace flatmarch::cli

@@ -1,0 +1,148 @@
+#include "cli/common.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "backends/oracle/oracle.hpp"
+
+namespace flatmarch::cli {
+
+namespace {
+
+double now_seconds() {
+  using clock = std::chrono::steady_clock;
+  return std::chrono::duration<double>(clock::now().time_since_epoch()).count();
+}
+
+double parse_number(const std::string& option, const std::string& text) {
+  size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(v)) throw UsageError(option + ": \"" + text + "\" is not a finite number");
+  return v;
+}
+
+}  // namespace
+
+Vec3 parse_vec3(const std::string& option, const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream in(text);
+  for (std::string part; std::getline(in, part, ',');) parts.push_back(part);
+  if (parts.size() != 3 || text.back() == ',') throw UsageError(option + ": expected X,Y,Z, got \"" + text + "\"");
+  return {parse_number(option, parts[0]), parse_number(option, parts[1]), parse_number(option, parts[2])};
+}
+
+std::pair<int, int> parse_size(const std::string& option, const std::string& text) {
+  const size_t x = text.find('x');
+  constexpr int kMax = 16384;
+  int w = 0, h = 0;
+  try {
+    size_t uw = 0, uh = 0;
+    if (x != std::string::npos) {
+      w = std::stoi(text.substr(0, x), &uw);
+      h = std::stoi(text.substr(x + 1), &uh);
+    }
+    if (x == std::string::npos || uw != x || uh != text.size() - x - 1) w = h = 0;
+  } catch (const std::exception&) {
+    w = h = 0;
+  }
+  if (w < 1 || h < 1 || w > kMax || h > kMax)
+    throw UsageError(option + ": expected WxH with 1 <= W, H <= " + std::to_string(kMax) + ", got \"" + text + "\"");
+  return {w, h};
+}
+
+void MarchOptions::add_to(CLI::App& app) {
+  std::string names;
+  for (const auto& b : backends()) names += (names.empty() ? "" : ", ") + b->name();
+  app.add_option("--backend", backend, "Backend: " + names + " (see `flatmarch backends`)")->capture_default_str();
+  app.add_option("--method", method, "Method: sphere, relaxed, analytic, oracle (default: the backend's first)");
+  app.add_option("--eps", params.eps, "Hit threshold")->capture_default_str();
+  app.add_option("--offset", params.offset, "Re-entry push after a gluing")->capture_default_str();
+  app.add_option("--max-steps", params.max_steps, "Kernel iterations before a ray gives up")->capture_default_str();
+  app.add_option("--max-distance", params.max_distance, "Path length before a ray gives up")->capture_default_str();
+  app.add_option("--omega", params.omega, "Over-relaxation factor of the relaxed method")->capture_default_str();
+  app.add_option("--precision", precision, "f32 or f64 (f64 on CPU backends)")->capture_default_str();
+}
+
+const Backend& MarchOptions::resolve() {
+  const Backend* b = find_backend(backend);
+  if (!b) throw UsageError("--backend: unknown backend \"" + backend + "\" (see `flatmarch backends`)");
+  const Availability a = b->availability();
+  if (!a.available) throw UnavailableError("backend " + backend + " is unavailable here: " + a.reason);
+  const std::vector<Method> methods = b->methods();
+  if (method.empty()) {
+    params.method = methods.front();
+  } else {
+    const auto m = parse_method(method);
+    if (!m) throw UsageError("--method: unknown method \"" + method + "\" (sphere, relaxed, analytic, oracle)");
+    if (std::find(methods.begin(), methods.end(), *m) == methods.end())
+      throw UsageError("--method: backend " + backend + " does not run method " + method);
+    params.method = *m;
+  }
+  if (precision == "f32")
+    params.precision = Precision::f32;
+  else if (precision == "f64")
+    params.precision = Precision::f64;
+  else
+    throw UsageError("--precision: expected f32 or f64, got \"" + precision + "\"");
+  if (!(params.eps > 0.0) || !std::isfinite(params.eps)) throw UsageError("--eps: must be a positive number");
+  if (!(params.offset > 0.0) || !std::isfinite(params.offset)) throw UsageError("--offset: must be a positive number");
+  if (params.max_steps < 1 || params.max_steps > 100'000'000) throw UsageError("--max-steps: must lie in [1, 1e8]");
+  if (!(params.max_distance > 0.0) || !std::isfinite(params.max_distance))
+    throw UsageError("--max-distance: must be a positive number");
+  if (!(params.omega >= 1.0 && params.omega < 2.0)) throw UsageError("--omega: must lie in [1, 2)");
+  return *b;
+}
+
+void CameraOptions::add_to(CLI::App& app) {
+  app.add_option("--camera-polygon", polygon, "Polygon of the camera position");
+  app.add_option("--position", position, "Camera position X,Y,Z in that polygon's coordinates");
+  app.add_option("--yaw", yaw_deg, "Camera yaw in degrees (0 looks along +x)");
+  app.add_option("--pitch", pitch_deg, "Camera pitch in degrees, in [-90, 90]");
+  app.add_option("--fov", fov_deg, "Vertical field of view in degrees, in (0, 180)");
+}
+
+Camera CameraOptions::apply(const Scene& scene) const {
+  Camera c = scene.camera;
+  if (polygon) c.polygon = *polygon;
+  if (!position.empty()) c.position = parse_vec3("--position", position);
+  if (yaw_deg) c.yaw_deg = *yaw_deg;
+  if (pitch_deg) c.pitch_deg = *pitch_deg;
+  if (fov_deg) c.fov_deg = *fov_deg;
+  if (!std::isfinite(c.yaw_deg)) throw UsageError("--yaw: must be finite");
+  if (!(std::abs(c.pitch_deg) <= 90.0)) throw UsageError("--pitch: must lie in [-90, 90]");
+  if (!(c.fov_deg > 0.0 && c.fov_deg < 180.0)) throw UsageError("--fov: must lie in (0, 180)");
+  if (auto problem = ray_problem(scene, Ray{c.polygon, c.position, Vec3(1.0, 0.0, 0.0)}))
+    throw UsageError("camera: " + *problem);
+  return c;
+}
+
+ProgressReporter::ProgressReporter(std::string label, bool quiet)
+    : label_(std::move(label)), quiet_(quiet), tty_(isatty(fileno(stderr)) != 0), started_(now_seconds()) {}
+
+void ProgressReporter::operator()(double fraction) {
+  if (quiet_) return;
+  const double t = now_seconds();
+  const double since = t - started_;
+  // Short work stays silent; a terminal gets a live line, a log a line every 5 seconds.
+  if (since < 1.0 || (!tty_ && t - last_ < 5.0) || (tty_ && t - last_ < 0.1)) return;
+  last_ = t;
+  const double eta = fraction > 0.0 ? since * (1.0 - fraction) / fraction : 0.0;
+  std::fprintf(stderr, "%s%s: %3.0f%%, %.0f s left%s", tty_ ? "\r" : "", label_.c_str(), 100.0 * fraction, eta,
+               tty_ ? "   " : "\n");
+  std::fflush(stderr);
+}
+
+void ProgressReporter::done() {
+  if (!quiet_ && tty_ && last_ >= 0.0) std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 30, "");
+}
+
+}  // namespace flatmarch::cli

@@ -1,0 +1,65 @@
+// What the subcommands share: errors with their exit codes, march options, argument parsing.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include <CLI/CLI.hpp>
+
+#include "backends/backend.hpp"
+
+namespace flatmarch::cli {
+
+// A bad argument: printed as `error: ...`, exit code 2 (scene errors are SceneError, also 2).
+class UsageError : public std::runtime_error {
+ public:
+  explicit UsageError(const std::string& what) : std::runtime_error("error: " + what) {}
+};
+
+// An unavailable backend: exit code 3.
+class UnavailableError : public std::runtime_error {
+ public:
+  explicit UnavailableError(const std::string& what) : std::runtime_error("error: " + what) {}
+};
+
+Vec3 parse_vec3(const std::string& option, const std::string& text);
+std::pair<int, int> parse_size(const std::string& option, const std::string& text);
+
+// The backend and march parameters of render and trace (DESIGN.md section 3).
+struct MarchOptions {
+  std::string backend = "oracle";
+  std::string method;  // empty: the backend's first method
+  MarchParams params;
+  std::string precision = "f32";
+
+  void add_to(CLI::App& app);
+  // Looks the backend up (UsageError if unknown, UnavailableError if unavailable here) and
+  // checks the parameters against it.
+  const Backend& resolve();
+};
+
+// Camera overrides of render (DESIGN.md section 5).
+struct CameraOptions {
+  std::optional<int> polygon;
+  std::string position;
+  std::optional<double> yaw_deg, pitch_deg, fov_deg;
+
+  void add_to(CLI::App& app);
+  Camera apply(const Scene& scene) const;  // validated against the scene
+};
+
+// Progress on stderr for long work: a live line on a terminal, a line every few seconds otherwise.
+class ProgressReporter {
+ public:
+  explicit ProgressReporter(std::string label, bool quiet = false);
+  void operator()(double fraction);
+  void done();
+
+ private:
+  std::string label_;
+  bool quiet_, tty_;
+  double started_, last_ = -1.0;
+};
+
+}  // namespace flatmarch::cli

@@ -1,0 +1,38 @@
+// The camera of DESIGN.md section 2. Every backend builds its primary rays from this, so that
+// images are comparable pixel by pixel.
+#pragma once
+
+#include <cmath>
+
+#include <glm/glm.hpp>
+
+namespace flatmarch {
+
+template <typename T>
+struct CameraBasis {
+  glm::vec<3, T> forward, right, up;
+  T tan_half_fov;  // of the vertical field of view
+  T aspect;        // width / height
+};
+
+template <typename T>
+CameraBasis<T> camera_basis(T yaw_deg, T pitch_deg, T fov_deg, int width, int height) {
+  const T a = glm::radians(yaw_deg), b = glm::radians(pitch_deg);
+  CameraBasis<T> c;
+  c.forward = {std::cos(b) * std::cos(a), std::cos(b) * std::sin(a), std::sin(b)};
+  c.right = {std::sin(a), -std::cos(a), T(0)};
+  c.up = glm::cross(c.right, c.forward);
+  c.tan_half_fov = std::tan(glm::radians(fov_deg) / T(2));
+  c.aspect = T(width) / T(height);
+  return c;
+}
+
+// Unit direction of pixel (i, j), row j = 0 at the top.
+template <typename T>
+glm::vec<3, T> camera_ray(const CameraBasis<T>& c, int i, int j, int width, int height) {
+  const T u = (T(2) * (T(i) + T(0.5)) / T(width) - T(1)) * c.aspect * c.tan_half_fov;
+  const T v = (T(1) - T(2) * (T(j) + T(0.5)) / T(height)) * c.tan_half_fov;
+  return glm::normalize(c.forward + u * c.right + v * c.up);
+}
+
+}  // namespace flatmarch

@@ -1,0 +1,21 @@
+// Writing frames (DESIGN.md section 4): the colour as an 8-bit sRGB PNG and every AOV in one
+// multi-channel float EXR beside it (out.png -> out.exr), both through OpenImageIO.
+#pragma once
+
+#include <filesystem>
+
+#include "backends/backend.hpp"
+
+namespace flatmarch {
+
+// The EXR written beside a PNG.
+std::filesystem::path aov_path(const std::filesystem::path& png);
+
+// Throws std::runtime_error with OpenImageIO's message when a file cannot be written.
+void write_png(const Frame& frame, const std::filesystem::path& png);
+void write_aov_exr(const Frame& frame, const std::filesystem::path& exr);
+
+// Reads an EXR written by write_aov_exr back into a frame.
+Frame read_aov_exr(const std::filesystem::path& exr);
+
+}  // namespace flatmarch

@@ -1,0 +1,15 @@
+// Transport traces as JSON (DESIGN.md section 4).
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "backends/backend.hpp"
+
+namespace flatmarch {
+
+nlohmann::ordered_json trace_to_json(const std::string& scene, const std::string& backend, Method method,
+                             const Ray& ray, const Trace& trace);
+
+}  // namespace flatmarch
