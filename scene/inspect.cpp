@@ -30,8 +30,8 @@ nlohmann::ordered_json inspect(const Scene& scene) {
   nlohmann::ordered_json out;
   out["scene"] = scene.name;
 
-  auto& polygons = out["polygons"] = nlohmann::ordered_json::array();
-  auto& edges = out["edges"] = nlohmann::ordered_json::array();
+  nlohmann::ordered_json polygons = nlohmann::ordered_json::array();
+  nlohmann::ordered_json edges = nlohmann::ordered_json::array();
   for (size_t p = 0; p < scene.polygons.size(); ++p) {
     const Polygon& polygon = scene.polygons[p];
     nlohmann::ordered_json vertices = nlohmann::ordered_json::array(), angles = nlohmann::ordered_json::array();
@@ -59,14 +59,14 @@ nlohmann::ordered_json inspect(const Scene& scene) {
     }
   }
 
-  auto& gluings = out["gluings"] = nlohmann::ordered_json::array();
+  nlohmann::ordered_json gluings = nlohmann::ordered_json::array();
   for (const Gluing& g : scene.gluings)
     gluings.push_back({{"edges", {{g.a.polygon, g.a.edge}, {g.b.polygon, g.b.edge}}},
                        {"written_as", map_name(g.map)},
                        {"type", to_string(g.type)},
                        {"map", map_json(g.g)}});
 
-  auto& classes = out["vertex_classes"] = nlohmann::ordered_json::array();
+  nlohmann::ordered_json classes = nlohmann::ordered_json::array();
   for (const VertexClass& vc : scene.vertex_classes) {
     nlohmann::ordered_json corners = nlohmann::ordered_json::array();
     for (const Corner& c : vc.corners) corners.push_back({c.polygon, c.vertex});
@@ -76,6 +76,11 @@ nlohmann::ordered_json inspect(const Scene& scene) {
                        {"singular", vc.singular},
                        {"boundary", vc.boundary}});
   }
+
+  out["polygons"] = std::move(polygons);
+  out["edges"] = std::move(edges);
+  out["gluings"] = std::move(gluings);
+  out["vertex_classes"] = std::move(classes);
 
   const Topology& t = scene.topology;
   out["euler_characteristic"] = t.euler_characteristic;
@@ -87,16 +92,18 @@ nlohmann::ordered_json inspect(const Scene& scene) {
   out["height"] = scene.height;
   out["period"] = scene.period ? nlohmann::ordered_json(*scene.period) : nlohmann::ordered_json();
   out["floor"] = scene.floor;
-  auto& objects = out["objects"] = nlohmann::ordered_json::array();
+  nlohmann::ordered_json objects = nlohmann::ordered_json::array();
   for (size_t k = 0; k < scene.objects.size(); ++k) {
     const Object& o = scene.objects[k];
     objects.push_back({{"index", k}, {"type", to_string(o.type)}, {"polygon", o.polygon}, {"center", point(o.center)}});
   }
-  auto& markers = out["markers"] = nlohmann::ordered_json::array();
+  nlohmann::ordered_json markers = nlohmann::ordered_json::array();
   for (size_t m = 0; m < scene.markers.size(); ++m)
     markers.push_back({{"index", scene.objects.size() + m},
                        {"vertex_class", scene.markers[m].vertex_class},
                        {"radius", scene.markers[m].radius}});
+  out["objects"] = std::move(objects);
+  out["markers"] = std::move(markers);
   const Camera& c = scene.camera;
   out["camera"] = {{"polygon", c.polygon},
                    {"position", point(c.position)},
