@@ -9,20 +9,23 @@ namespace flatmarch {
 
 namespace {
 
-constexpr std::array<std::pair<Method, const char*>, 4> kMethods{{
-    {Method::sphere, "sphere"}, {Method::relaxed, "relaxed"}, {Method::analytic, "analytic"}, {Method::oracle, "oracle"}}};
+constexpr std::array<std::pair<Method, const char*>, 4> kMethods{{{Method::sphere, "sphere"},
+                                                                  {Method::relaxed, "relaxed"},
+                                                                  {Method::analytic, "analytic"},
+                                                                  {Method::oracle, "oracle"}}};
 
-constexpr std::array<std::pair<EventKind, const char*>, 11> kEventKinds{{{EventKind::gluing, "gluing"},
-                                                                        {EventKind::mirror, "mirror"},
-                                                                        {EventKind::enter, "enter"},
-                                                                        {EventKind::object, "object"},
-                                                                        {EventKind::wall, "wall"},
-                                                                        {EventKind::floor, "floor"},
-                                                                        {EventKind::escape, "escape"},
-                                                                        {EventKind::vertex, "vertex"},
-                                                                        {EventKind::max_steps, "max_steps"},
-                                                                        {EventKind::max_distance, "max_distance"},
-                                                                        {EventKind::miss, "miss"}}};
+constexpr std::array<std::pair<EventKind, const char*>, 11> kEventKinds{
+    {{EventKind::gluing, "gluing"},
+     {EventKind::mirror, "mirror"},
+     {EventKind::enter, "enter"},
+     {EventKind::object, "object"},
+     {EventKind::wall, "wall"},
+     {EventKind::floor, "floor"},
+     {EventKind::escape, "escape"},
+     {EventKind::vertex, "vertex"},
+     {EventKind::max_steps, "max_steps"},
+     {EventKind::max_distance, "max_distance"},
+     {EventKind::miss, "miss"}}};
 
 template <typename E, size_t N>
 const char* name_of(const std::array<std::pair<E, const char*>, N>& table, E value) {
@@ -32,7 +35,8 @@ const char* name_of(const std::array<std::pair<E, const char*>, N>& table, E val
 }
 
 template <typename E, size_t N>
-std::optional<E> value_of(const std::array<std::pair<E, const char*>, N>& table, const std::string& name) {
+std::optional<E> value_of(const std::array<std::pair<E, const char*>, N>& table,
+                          const std::string& name) {
   for (const auto& [v, n] : table)
     if (name == n) return v;
   return std::nullopt;
@@ -40,10 +44,18 @@ std::optional<E> value_of(const std::array<std::pair<E, const char*>, N>& table,
 
 }  // namespace
 
-const char* to_string(Method m) { return name_of(kMethods, m); }
-std::optional<Method> parse_method(const std::string& name) { return value_of(kMethods, name); }
-const char* to_string(EventKind k) { return name_of(kEventKinds, k); }
-std::optional<EventKind> parse_event_kind(const std::string& name) { return value_of(kEventKinds, name); }
+const char* to_string(Method m) {
+  return name_of(kMethods, m);
+}
+std::optional<Method> parse_method(const std::string& name) {
+  return value_of(kMethods, name);
+}
+const char* to_string(EventKind k) {
+  return name_of(kEventKinds, k);
+}
+std::optional<EventKind> parse_event_kind(const std::string& name) {
+  return value_of(kEventKinds, name);
+}
 
 bool is_final(EventKind k) {
   return k != EventKind::gluing && k != EventKind::mirror && k != EventKind::enter;
@@ -51,14 +63,22 @@ bool is_final(EventKind k) {
 
 int hit_code(EventKind final_kind, int object) {
   switch (final_kind) {
-    case EventKind::object: return object;
-    case EventKind::wall: return kHitWall;
-    case EventKind::floor: return kHitFloor;
-    case EventKind::escape: return kHitEscape;
-    case EventKind::vertex: return kHitVertex;
-    case EventKind::max_steps: return kHitMaxSteps;
-    case EventKind::max_distance: return kHitMaxDistance;
-    default: return kHitMiss;
+    case EventKind::object:
+      return object;
+    case EventKind::wall:
+      return kHitWall;
+    case EventKind::floor:
+      return kHitFloor;
+    case EventKind::escape:
+      return kHitEscape;
+    case EventKind::vertex:
+      return kHitVertex;
+    case EventKind::max_steps:
+      return kHitMaxSteps;
+    case EventKind::max_distance:
+      return kHitMaxDistance;
+    default:
+      return kHitMiss;
   }
 }
 

@@ -38,7 +38,19 @@ struct Ray {
 
 // Events of a transport trace. `enter` (a ray from a camera outside the band entering a room)
 // and `miss` (never entering one) extend DESIGN.md's list.
-enum class EventKind { gluing, mirror, enter, object, wall, floor, escape, vertex, max_steps, max_distance, miss };
+enum class EventKind {
+  gluing,
+  mirror,
+  enter,
+  object,
+  wall,
+  floor,
+  escape,
+  vertex,
+  max_steps,
+  max_distance,
+  miss
+};
 const char* to_string(EventKind k);
 std::optional<EventKind> parse_event_kind(const std::string& name);
 bool is_final(EventKind k);
@@ -68,7 +80,9 @@ struct Frame {
 
   Frame() = default;
   Frame(int w, int h);
-  size_t pixel(int i, int j) const { return static_cast<size_t>(j) * static_cast<size_t>(width) + static_cast<size_t>(i); }
+  size_t pixel(int i, int j) const {
+    return static_cast<size_t>(j) * static_cast<size_t>(width) + static_cast<size_t>(i);
+  }
 };
 
 struct Availability {

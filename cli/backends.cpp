@@ -9,7 +9,8 @@
 namespace flatmarch::cli {
 
 void add_backends(CLI::App& app) {
-  auto* cmd = app.add_subcommand("backends", "List the backends, whether each is available here, and why not.");
+  auto* cmd = app.add_subcommand("backends",
+                                 "List the backends, whether each is available here, and why not.");
   auto json = std::make_shared<bool>(false);
   cmd->add_flag("--json", *json, "Print JSON instead of a table");
   cmd->callback([json] {
@@ -31,11 +32,14 @@ void add_backends(CLI::App& app) {
     std::printf("%-10s %-11s %-28s %s\n", "backend", "available", "methods", "description");
     for (const auto& b : list) {
       std::string methods;
-      for (const auto& m : b["methods"]) methods += (methods.empty() ? "" : ",") + m.get<std::string>();
+      for (const auto& m : b["methods"])
+        methods += (methods.empty() ? "" : ",") + m.get<std::string>();
       const bool ok = b["available"].get<bool>();
       std::printf("%-10s %-11s %-28s %s\n", b["name"].get<std::string>().c_str(), ok ? "yes" : "NO",
                   methods.c_str(),
-                  (ok ? b["description"].get<std::string>() : "unavailable: " + b["reason"].get<std::string>()).c_str());
+                  (ok ? b["description"].get<std::string>()
+                      : "unavailable: " + b["reason"].get<std::string>())
+                      .c_str());
     }
   });
 }

@@ -26,7 +26,8 @@ double parse_number(const std::string& option, const std::string& text) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != text.size() || !std::isfinite(v)) throw UsageError(option + ": \"" + text + "\" is not a finite number");
+  if (used != text.size() || !std::isfinite(v))
+    throw UsageError(option + ": \"" + text + "\" is not a finite number");
   return v;
 }
 
@@ -36,8 +37,10 @@ Vec3 parse_vec3(const std::string& option, const std::string& text) {
   std::vector<std::string> parts;
   std::stringstream in(text);
   for (std::string part; std::getline(in, part, ',');) parts.push_back(part);
-  if (parts.size() != 3 || text.back() == ',') throw UsageError(option + ": expected X,Y,Z, got \"" + text + "\"");
-  return {parse_number(option, parts[0]), parse_number(option, parts[1]), parse_number(option, parts[2])};
+  if (parts.size() != 3 || text.back() == ',')
+    throw UsageError(option + ": expected X,Y,Z, got \"" + text + "\"");
+  return {parse_number(option, parts[0]), parse_number(option, parts[1]),
+          parse_number(option, parts[2])};
 }
 
 std::pair<int, int> parse_size(const std::string& option, const std::string& text) {
@@ -55,34 +58,45 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
     w = h = 0;
   }
   if (w < 1 || h < 1 || w > kMax || h > kMax)
-    throw UsageError(option + ": expected WxH with 1 <= W, H <= " + std::to_string(kMax) + ", got \"" + text + "\"");
+    throw UsageError(option + ": expected WxH with 1 <= W, H <= " + std::to_string(kMax) +
+                     ", got \"" + text + "\"");
   return {w, h};
 }
 
 void MarchOptions::add_to(CLI::App& app) {
   std::string names;
   for (const auto& b : backends()) names += (names.empty() ? "" : ", ") + b->name();
-  app.add_option("--backend", backend, "Backend: " + names + " (see `flatmarch backends`)")->capture_default_str();
-  app.add_option("--method", method, "Method: sphere, relaxed, analytic, oracle (default: the backend's first)");
+  app.add_option("--backend", backend, "Backend: " + names + " (see `flatmarch backends`)")
+      ->capture_default_str();
+  app.add_option("--method", method,
+                 "Method: sphere, relaxed, analytic, oracle (default: the backend's first)");
   app.add_option("--eps", params.eps, "Hit threshold")->capture_default_str();
   app.add_option("--offset", params.offset, "Re-entry push after a gluing")->capture_default_str();
-  app.add_option("--max-steps", params.max_steps, "Kernel iterations before a ray gives up")->capture_default_str();
-  app.add_option("--max-distance", params.max_distance, "Path length before a ray gives up")->capture_default_str();
-  app.add_option("--omega", params.omega, "Over-relaxation factor of the relaxed method")->capture_default_str();
-  app.add_option("--precision", precision, "f32 or f64 (f64 on CPU backends)")->capture_default_str();
+  app.add_option("--max-steps", params.max_steps, "Kernel iterations before a ray gives up")
+      ->capture_default_str();
+  app.add_option("--max-distance", params.max_distance, "Path length before a ray gives up")
+      ->capture_default_str();
+  app.add_option("--omega", params.omega, "Over-relaxation factor of the relaxed method")
+      ->capture_default_str();
+  app.add_option("--precision", precision, "f32 or f64 (f64 on CPU backends)")
+      ->capture_default_str();
 }
 
 const Backend& MarchOptions::resolve() {
   const Backend* b = find_backend(backend);
-  if (!b) throw UsageError("--backend: unknown backend \"" + backend + "\" (see `flatmarch backends`)");
+  if (!b)
+    throw UsageError("--backend: unknown backend \"" + backend + "\" (see `flatmarch backends`)");
   const Availability a = b->availability();
-  if (!a.available) throw UnavailableError("backend " + backend + " is unavailable here: " + a.reason);
+  if (!a.available)
+    throw UnavailableError("backend " + backend + " is unavailable here: " + a.reason);
   const std::vector<Method> methods = b->methods();
   if (method.empty()) {
     params.method = methods.front();
   } else {
     const auto m = parse_method(method);
-    if (!m) throw UsageError("--method: unknown method \"" + method + "\" (sphere, relaxed, analytic, oracle)");
+    if (!m)
+      throw UsageError("--method: unknown method \"" + method +
+                       "\" (sphere, relaxed, analytic, oracle)");
     if (std::find(methods.begin(), methods.end(), *m) == methods.end())
       throw UsageError("--method: backend " + backend + " does not run method " + method);
     params.method = *m;
@@ -93,9 +107,12 @@ const Backend& MarchOptions::resolve() {
     params.precision = Precision::f64;
   else
     throw UsageError("--precision: expected f32 or f64, got \"" + precision + "\"");
-  if (!(params.eps > 0.0) || !std::isfinite(params.eps)) throw UsageError("--eps: must be a positive number");
-  if (!(params.offset > 0.0) || !std::isfinite(params.offset)) throw UsageError("--offset: must be a positive number");
-  if (params.max_steps < 1 || params.max_steps > 100'000'000) throw UsageError("--max-steps: must lie in [1, 1e8]");
+  if (!(params.eps > 0.0) || !std::isfinite(params.eps))
+    throw UsageError("--eps: must be a positive number");
+  if (!(params.offset > 0.0) || !std::isfinite(params.offset))
+    throw UsageError("--offset: must be a positive number");
+  if (params.max_steps < 1 || params.max_steps > 100'000'000)
+    throw UsageError("--max-steps: must lie in [1, 1e8]");
   if (!(params.max_distance > 0.0) || !std::isfinite(params.max_distance))
     throw UsageError("--max-distance: must be a positive number");
   if (!(params.omega >= 1.0 && params.omega < 2.0)) throw UsageError("--omega: must lie in [1, 2)");
@@ -126,7 +143,10 @@ Camera CameraOptions::apply(const Scene& scene) const {
 }
 
 ProgressReporter::ProgressReporter(std::string label, bool quiet)
-    : label_(std::move(label)), quiet_(quiet), tty_(isatty(fileno(stderr)) != 0), started_(now_seconds()) {}
+    : label_(std::move(label)),
+      quiet_(quiet),
+      tty_(isatty(fileno(stderr)) != 0),
+      started_(now_seconds()) {}
 
 void ProgressReporter::operator()(double fraction) {
   if (quiet_) return;
@@ -136,13 +156,14 @@ void ProgressReporter::operator()(double fraction) {
   if (since < 1.0 || (!tty_ && t - last_ < 5.0) || (tty_ && t - last_ < 0.1)) return;
   last_ = t;
   const double eta = fraction > 0.0 ? since * (1.0 - fraction) / fraction : 0.0;
-  std::fprintf(stderr, "%s%s: %3.0f%%, %.0f s left%s", tty_ ? "\r" : "", label_.c_str(), 100.0 * fraction, eta,
-               tty_ ? "   " : "\n");
+  std::fprintf(stderr, "%s%s: %3.0f%%, %.0f s left%s", tty_ ? "\r" : "", label_.c_str(),
+               100.0 * fraction, eta, tty_ ? "   " : "\n");
   std::fflush(stderr);
 }
 
 void ProgressReporter::done() {
-  if (!quiet_ && tty_ && last_ >= 0.0) std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 30, "");
+  if (!quiet_ && tty_ && last_ >= 0.0)
+    std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 30, "");
 }
 
 }  // namespace flatmarch::cli

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   cli::add_render(app);
   cli::add_trace(app);
   cli::add_backends(app);
+  cli::add_gallery(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -26,7 +27,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "error: %s\nRun `flatmarch --help` or `flatmarch COMMAND --help` for usage.\n", e.what());
+    std::fprintf(stderr,
+                 "error: %s\nRun `flatmarch --help` or `flatmarch COMMAND --help` for usage.\n",
+                 e.what());
     return 2;
   } catch (const SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());

@@ -32,16 +32,19 @@ void add_render(CLI::App& app) {
     const Scene scene = load_scene(o->scene);
     const Camera camera = o->camera.apply(scene);
     const auto start = std::chrono::steady_clock::now();
-    ProgressReporter progress("rendering " + scene.name + " " + o->size + " with " + backend.name(), o->quiet);
-    const Frame frame = backend.render(scene, camera, w, h, o->march.params, [&](double f) { progress(f); });
+    ProgressReporter progress("rendering " + scene.name + " " + o->size + " with " + backend.name(),
+                              o->quiet);
+    const Frame frame =
+        backend.render(scene, camera, w, h, o->march.params, [&](double f) { progress(f); });
     progress.done();
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_png(frame, o->out);
     write_aov_exr(frame, aov_path(o->out));
     if (!o->quiet)
       std::fprintf(stderr, "wrote %s and %s (%dx%d, %s/%s, %.2f s)\n", o->out.c_str(),
-                   aov_path(o->out).string().c_str(), w, h, backend.name().c_str(), to_string(o->march.params.method),
-                   seconds);
+                   aov_path(o->out).string().c_str(), w, h, backend.name().c_str(),
+                   to_string(o->march.params.method), seconds);
   });
 }
 

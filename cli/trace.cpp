@@ -21,20 +21,25 @@ void add_trace(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("SCENE", o->scene, "Scene file (JSON)")->required();
-  cmd->add_option("--from", o->from, "Ray origin X,Y,Z in the coordinates of --polygon")->required();
+  cmd->add_option("--from", o->from, "Ray origin X,Y,Z in the coordinates of --polygon")
+      ->required();
   cmd->add_option("--dir", o->dir, "Ray direction DX,DY,DZ (normalised)")->required();
   cmd->add_option("--polygon", o->polygon, "Polygon of the origin")->capture_default_str();
   cmd->add_option("--max-events", o->max_events, "Events to print at most")->capture_default_str();
   o->march.add_to(*cmd);
   cmd->callback([o] {
-    if (o->max_events < 1 || o->max_events > 10'000'000) throw UsageError("--max-events: must lie in [1, 1e7]");
+    if (o->max_events < 1 || o->max_events > 10'000'000)
+      throw UsageError("--max-events: must lie in [1, 1e7]");
     const Backend& backend = o->march.resolve();
     const Scene scene = load_scene(o->scene);
     Ray ray{o->polygon, parse_vec3("--from", o->from), parse_vec3("--dir", o->dir)};
-    if (auto problem = ray_problem(scene, ray)) throw UsageError("--from/--dir/--polygon: " + *problem);
+    if (auto problem = ray_problem(scene, ray))
+      throw UsageError("--from/--dir/--polygon: " + *problem);
     ray.dir = glm::normalize(ray.dir);
     const Trace trace = backend.trace(scene, ray, o->march.params, o->max_events);
-    std::cout << trace_to_json(scene.name, backend.name(), o->march.params.method, ray, trace).dump(2) << "\n";
+    std::cout
+        << trace_to_json(scene.name, backend.name(), o->march.params.method, ray, trace).dump(2)
+        << "\n";
   });
 }
 

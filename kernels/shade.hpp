@@ -27,7 +27,8 @@ glm::vec<3, T> shade(int hit, int crossings, glm::vec<3, T> normal, glm::vec<3, 
   } else if (hit == kHitWall) {
     surface = glm::vec<3, T>(T(kWallGrey));
   } else if (hit == kHitFloor) {
-    const long check = std::lround(std::floor(at.x / T(kFloorCheck)) + std::floor(at.y / T(kFloorCheck)));
+    const long check =
+        std::lround(std::floor(at.x / T(kFloorCheck)) + std::floor(at.y / T(kFloorCheck)));
     surface = glm::vec<3, T>(T((check & 1) ? kFloorDarkGrey : kWallGrey));
   } else if (hit == kHitMaxSteps || hit == kHitVertex) {
     surface = glm::vec<3, T>(T(0));  // undecided rays show as black

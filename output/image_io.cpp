@@ -12,8 +12,11 @@ namespace {
 constexpr const char* kAovChannels[] = {"R", "G", "B", "steps", "crossings", "hit", "t"};
 constexpr int kAovCount = 7;
 
-void check(bool ok, const OIIO::ImageBuf& buf, const std::filesystem::path& path, const char* doing) {
-  if (!ok) throw std::runtime_error("cannot " + std::string(doing) + " " + path.string() + ": " + buf.geterror());
+void check(bool ok, const OIIO::ImageBuf& buf, const std::filesystem::path& path,
+           const char* doing) {
+  if (!ok)
+    throw std::runtime_error("cannot " + std::string(doing) + " " + path.string() + ": " +
+                             buf.geterror());
 }
 
 }  // namespace
@@ -42,8 +45,9 @@ void write_aov_exr(const Frame& frame, const std::filesystem::path& exr) {
   for (int j = 0; j < frame.height; ++j)
     for (int i = 0; i < frame.width; ++i) {
       const size_t px = frame.pixel(i, j);
-      pixel = {frame.rgb[3 * px], frame.rgb[3 * px + 1], frame.rgb[3 * px + 2], frame.steps[px],
-               frame.crossings[px], frame.hit[px], frame.t[px]};
+      pixel = {frame.rgb[3 * px], frame.rgb[3 * px + 1], frame.rgb[3 * px + 2],
+               frame.steps[px],   frame.crossings[px],   frame.hit[px],
+               frame.t[px]};
       buf.setpixel(i, j, pixel.data());
     }
   check(buf.write(exr.string()), buf, exr, "write");
@@ -53,7 +57,8 @@ Frame read_aov_exr(const std::filesystem::path& exr) {
   OIIO::ImageBuf buf(exr.string());
   check(buf.read(0, 0, true, OIIO::TypeDesc::FLOAT), buf, exr, "read");
   const OIIO::ImageSpec& spec = buf.spec();
-  if (spec.nchannels != kAovCount) throw std::runtime_error(exr.string() + ": expected 7 AOV channels");
+  if (spec.nchannels != kAovCount)
+    throw std::runtime_error(exr.string() + ": expected 7 AOV channels");
   Frame frame(spec.width, spec.height);
   std::vector<float> pixel(kAovCount);
   for (int j = 0; j < frame.height; ++j)

@@ -9,7 +9,7 @@
 
 namespace flatmarch {
 
-nlohmann::ordered_json trace_to_json(const std::string& scene, const std::string& backend, Method method,
-                             const Ray& ray, const Trace& trace);
+nlohmann::ordered_json trace_to_json(const std::string& scene, const std::string& backend,
+                                     Method method, const Ray& ray, const Trace& trace);
 
 }  // namespace flatmarch

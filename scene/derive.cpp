@@ -18,7 +18,9 @@ std::string format_point(Vec2 p) {
 }
 
 // Signed distance of c from the line through a and b (positive on the left).
-double side(Vec2 a, Vec2 b, Vec2 c) { return cross(b - a, c - a) / glm::length(b - a); }
+double side(Vec2 a, Vec2 b, Vec2 c) {
+  return cross(b - a, c - a) / glm::length(b - a);
+}
 
 bool segments_touch(Vec2 a, Vec2 b, Vec2 c, Vec2 d, double tol) {
   const double o1 = side(a, b, c), o2 = side(a, b, d), o3 = side(c, d, a), o4 = side(c, d, b);
@@ -43,7 +45,9 @@ Mat2 rotation_between(Vec2 u, Vec2 v) {
 
 class UnionFind {
  public:
-  explicit UnionFind(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), size_t{0}); }
+  explicit UnionFind(size_t n) : parent_(n) {
+    std::iota(parent_.begin(), parent_.end(), size_t{0});
+  }
   size_t find(size_t i) {
     while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
     return i;
@@ -67,8 +71,8 @@ std::optional<PolygonProblem> check_polygon(const Polygon& polygon, double scale
   for (int i = 0; i < n; ++i)
     for (int j = i + 2; j < n; ++j)
       if (glm::length(polygon.vertex(j) - polygon.vertex(i)) <= tol)
-        return PolygonProblem{j, "repeats vertex " + std::to_string(i) + " " +
-                                     format_point(polygon.vertex(i))};
+        return PolygonProblem{
+            j, "repeats vertex " + std::to_string(i) + " " + format_point(polygon.vertex(i))};
   const double area = polygon.area();
   if (std::abs(area) <= tol * scale) return PolygonProblem{-1, "the polygon has zero area"};
   if (area < 0.0)
@@ -76,9 +80,9 @@ std::optional<PolygonProblem> check_polygon(const Polygon& polygon, double scale
   for (int i = 0; i < n; ++i) {
     const Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1), c = polygon.vertex(i + 2);
     if (std::abs(side(a, b, c)) <= tol && glm::dot(a - b, c - b) > 0.0)
-      return PolygonProblem{(i + 1) % n, "edges " + std::to_string(i) + " and " +
-                                             std::to_string((i + 1) % n) +
-                                             " fold back onto each other: the polygon is not simple"};
+      return PolygonProblem{(i + 1) % n,
+                            "edges " + std::to_string(i) + " and " + std::to_string((i + 1) % n) +
+                                " fold back onto each other: the polygon is not simple"};
   }
   for (int i = 0; i < n; ++i)
     for (int j = i + 2; j < n; ++j) {
@@ -178,7 +182,8 @@ void init_edges(Polygon& polygon, EdgeKind boundary) {
 void attach_gluing(Scene& scene, int index) {
   const Gluing& gl = scene.gluings[static_cast<size_t>(index)];
   const auto attach = [&](EdgeRef from, EdgeRef to, const Affine2& map) {
-    Edge& e = scene.polygons[static_cast<size_t>(from.polygon)].edges[static_cast<size_t>(from.edge)];
+    Edge& e =
+        scene.polygons[static_cast<size_t>(from.polygon)].edges[static_cast<size_t>(from.edge)];
     e.kind = EdgeKind::glued;
     e.gluing = index;
     e.to = to;
@@ -215,12 +220,14 @@ void derive_vertex_classes(Scene& scene) {
     scene.corner_class[p].resize(polygon.vertices.size());
     for (int v = 0; v < polygon.size(); ++v) {
       const size_t root = classes.find(corner(static_cast<int>(p), v));
-      auto [it, added] = class_of_root.try_emplace(root, static_cast<int>(scene.vertex_classes.size()));
+      auto [it, added] =
+          class_of_root.try_emplace(root, static_cast<int>(scene.vertex_classes.size()));
       if (added) scene.vertex_classes.emplace_back();
       VertexClass& vc = scene.vertex_classes[static_cast<size_t>(it->second)];
       vc.corners.push_back({static_cast<int>(p), v});
       vc.cone_angle += polygon.corner_angle(v);
-      const EdgeKind in = polygon.edges[static_cast<size_t>((v + polygon.size() - 1) % polygon.size())].kind;
+      const EdgeKind in =
+          polygon.edges[static_cast<size_t>((v + polygon.size() - 1) % polygon.size())].kind;
       const EdgeKind out = polygon.edges[static_cast<size_t>(v)].kind;
       vc.boundary = vc.boundary || in != EdgeKind::glued || out != EdgeKind::glued;
       scene.corner_class[p][static_cast<size_t>(v)] = it->second;
@@ -275,7 +282,8 @@ void derive_topology(Scene& scene) {
       if (polygon.edges[static_cast<size_t>(i)].kind == EdgeKind::glued) continue;
       ++boundary_edges;
       boundary.unite(static_cast<size_t>(scene.corner_class[p][static_cast<size_t>(i)]),
-                     static_cast<size_t>(scene.corner_class[p][static_cast<size_t>((i + 1) % polygon.size())]));
+                     static_cast<size_t>(
+                         scene.corner_class[p][static_cast<size_t>((i + 1) % polygon.size())]));
     }
   }
   t.boundary_components = 0;

@@ -12,10 +12,14 @@ using Mat2 = glm::dmat2;  // column-major, as GLSL: Mat2(column0, column1)
 inline constexpr double kPi = 3.14159265358979323846;
 
 // z-component of the 3D cross product: > 0 when b is counterclockwise of a.
-inline double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
+inline double cross(Vec2 a, Vec2 b) {
+  return a.x * b.y - a.y * b.x;
+}
 
 // Rotation by +90 degrees.
-inline Vec2 perp(Vec2 v) { return {-v.y, v.x}; }
+inline Vec2 perp(Vec2 v) {
+  return {-v.y, v.x};
+}
 
 // An affine map of the plane, x -> linear * x + translation.
 struct Affine2 {

@@ -5,21 +5,31 @@ namespace flatmarch {
 namespace {
 
 // Adding 0.0 prints -0.0 as 0.
-nlohmann::ordered_json point(Vec2 p) { return {p.x + 0.0, p.y + 0.0}; }
-nlohmann::ordered_json point(Vec3 p) { return {p.x, p.y, p.z}; }
+nlohmann::ordered_json point(Vec2 p) {
+  return {p.x + 0.0, p.y + 0.0};
+}
+nlohmann::ordered_json point(Vec3 p) {
+  return {p.x, p.y, p.z};
+}
 
 nlohmann::ordered_json map_json(const Affine2& m) {
   // Row-major, as scene files write matrices.
-  return {{"linear", {point(Vec2(m.linear[0][0], m.linear[1][0])), point(Vec2(m.linear[0][1], m.linear[1][1]))}},
-          {"translation", point(m.translation)}};
+  return {
+      {"linear",
+       {point(Vec2(m.linear[0][0], m.linear[1][0])), point(Vec2(m.linear[0][1], m.linear[1][1]))}},
+      {"translation", point(m.translation)}};
 }
 
 const char* map_name(GluingMap m) {
   switch (m) {
-    case GluingMap::isometry: return "isometry";
-    case GluingMap::reflection: return "reflection";
-    case GluingMap::similarity: return "similarity";
-    case GluingMap::matrix: return "matrix";
+    case GluingMap::isometry:
+      return "isometry";
+    case GluingMap::reflection:
+      return "reflection";
+    case GluingMap::similarity:
+      return "similarity";
+    case GluingMap::matrix:
+      return "matrix";
   }
   return "?";
 }
@@ -34,21 +44,23 @@ nlohmann::ordered_json inspect(const Scene& scene) {
   nlohmann::ordered_json edges = nlohmann::ordered_json::array();
   for (size_t p = 0; p < scene.polygons.size(); ++p) {
     const Polygon& polygon = scene.polygons[p];
-    nlohmann::ordered_json vertices = nlohmann::ordered_json::array(), angles = nlohmann::ordered_json::array();
+    nlohmann::ordered_json vertices = nlohmann::ordered_json::array(),
+                           angles = nlohmann::ordered_json::array();
     for (int v = 0; v < polygon.size(); ++v) {
       vertices.push_back(point(polygon.vertex(v)));
       angles.push_back(polygon.corner_angle(v));
     }
-    polygons.push_back({{"vertices", vertices}, {"corner_angles", angles}, {"area", polygon.area()}});
+    polygons.push_back(
+        {{"vertices", vertices}, {"corner_angles", angles}, {"area", polygon.area()}});
     for (int i = 0; i < polygon.size(); ++i) {
       const Edge& e = polygon.edges[static_cast<size_t>(i)];
       nlohmann::ordered_json edge = {{"polygon", p},
-                             {"edge", i},
-                             {"from", point(polygon.vertex(i))},
-                             {"to", point(polygon.vertex(i + 1))},
-                             {"length", e.length},
-                             {"normal", point(e.normal)},
-                             {"kind", to_string(e.kind)}};
+                                     {"edge", i},
+                                     {"from", point(polygon.vertex(i))},
+                                     {"to", point(polygon.vertex(i + 1))},
+                                     {"length", e.length},
+                                     {"normal", point(e.normal)},
+                                     {"kind", to_string(e.kind)}};
       if (e.kind == EdgeKind::glued) {
         edge["gluing"] = e.gluing;
         edge["to_polygon"] = e.to.polygon;
@@ -95,7 +107,10 @@ nlohmann::ordered_json inspect(const Scene& scene) {
   nlohmann::ordered_json objects = nlohmann::ordered_json::array();
   for (size_t k = 0; k < scene.objects.size(); ++k) {
     const Object& o = scene.objects[k];
-    objects.push_back({{"index", k}, {"type", to_string(o.type)}, {"polygon", o.polygon}, {"center", point(o.center)}});
+    objects.push_back({{"index", k},
+                       {"type", to_string(o.type)},
+                       {"polygon", o.polygon},
+                       {"center", point(o.center)}});
   }
   nlohmann::ordered_json markers = nlohmann::ordered_json::array();
   for (size_t m = 0; m < scene.markers.size(); ++m)

@@ -24,15 +24,22 @@ std::string escape_token(const std::string& key) {
 
 std::string json_type_name(const nlohmann::json& v) {
   switch (v.type()) {
-    case nlohmann::json::value_t::null: return "null";
-    case nlohmann::json::value_t::object: return "an object";
-    case nlohmann::json::value_t::array: return "an array";
-    case nlohmann::json::value_t::string: return "a string";
-    case nlohmann::json::value_t::boolean: return "a boolean";
+    case nlohmann::json::value_t::null:
+      return "null";
+    case nlohmann::json::value_t::object:
+      return "an object";
+    case nlohmann::json::value_t::array:
+      return "an array";
+    case nlohmann::json::value_t::string:
+      return "a string";
+    case nlohmann::json::value_t::boolean:
+      return "a boolean";
     case nlohmann::json::value_t::number_integer:
     case nlohmann::json::value_t::number_unsigned:
-    case nlohmann::json::value_t::number_float: return "a number";
-    default: return "an unsupported value";
+    case nlohmann::json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unsupported value";
   }
 }
 
@@ -100,9 +107,11 @@ std::string JsonNode::string() const {
 }
 
 int JsonNode::index(int limit, const char* what) const {
-  if (!value_->is_number()) fail(std::string("expected ") + what + " index, found " + json_type_name(*value_));
+  if (!value_->is_number())
+    fail(std::string("expected ") + what + " index, found " + json_type_name(*value_));
   const double v = value_->get<double>();
-  if (!(v == std::floor(v))) fail(std::string("expected an integer ") + what + " index, found " + value_->dump());
+  if (!(v == std::floor(v)))
+    fail(std::string("expected an integer ") + what + " index, found " + value_->dump());
   if (v < 0.0 || v >= static_cast<double>(limit))
     fail(std::string(what) + " index " + value_->dump() + " out of range (there " +
          (limit == 1 ? "is 1 " : "are " + std::to_string(limit) + " ") + what +
@@ -123,7 +132,8 @@ Vec3 JsonNode::vec3() const {
 Vec3 JsonNode::color() const {
   const Vec3 c = vec3();
   for (int i = 0; i < 3; ++i)
-    if (c[i] < 0.0 || c[i] > 1.0) (*this)[static_cast<size_t>(i)].fail("colour components lie in [0, 1]");
+    if (c[i] < 0.0 || c[i] > 1.0)
+      (*this)[static_cast<size_t>(i)].fail("colour components lie in [0, 1]");
   return c;
 }
 

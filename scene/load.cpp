@@ -86,14 +86,16 @@ void read_polygons(const JsonNode& root, Scene& scene, EdgeKind boundary) {
     const size_t nv = poly.array_size(3, SceneLimits::max_vertices_per_polygon);
     Polygon polygon;
     for (size_t v = 0; v < nv; ++v) polygon.vertices.push_back(poly[v].vec2());
-    for (Vec2 v : polygon.vertices) scene.scale = std::max({scene.scale, std::abs(v.x), std::abs(v.y)});
+    for (Vec2 v : polygon.vertices)
+      scene.scale = std::max({scene.scale, std::abs(v.x), std::abs(v.y)});
     scene.polygons.push_back(std::move(polygon));
     vertex_lists.push_back(poly);
   }
   for (size_t p = 0; p < n; ++p) {
     Polygon& polygon = scene.polygons[p];
     if (auto problem = check_polygon(polygon, scene.scale)) {
-      if (problem->vertex >= 0) vertex_lists[p][static_cast<size_t>(problem->vertex)].fail(problem->message);
+      if (problem->vertex >= 0)
+        vertex_lists[p][static_cast<size_t>(problem->vertex)].fail(problem->message);
       list[p].fail(problem->message);
     }
     init_edges(polygon, boundary);
@@ -107,7 +109,8 @@ void read_gluings(const JsonNode& root, Scene& scene) {
   for (const Polygon& p : scene.polygons) total_edges += p.vertices.size();
   const size_t n = list.array_size(0, total_edges / 2);
   std::vector<std::vector<int>> glued_by(scene.polygons.size());
-  for (size_t p = 0; p < scene.polygons.size(); ++p) glued_by[p].assign(scene.polygons[p].vertices.size(), -1);
+  for (size_t p = 0; p < scene.polygons.size(); ++p)
+    glued_by[p].assign(scene.polygons[p].vertices.size(), -1);
 
   for (size_t k = 0; k < n; ++k) {
     const JsonNode node = list[k];
@@ -128,7 +131,8 @@ void read_gluings(const JsonNode& root, Scene& scene) {
         else if (m == "similarity")
           gl.map = GluingMap::similarity;
         else
-          node["map"].fail("unknown map \"" + m + "\" (expected \"isometry\", \"reflection\" or \"similarity\")");
+          node["map"].fail("unknown map \"" + m +
+                           "\" (expected \"isometry\", \"reflection\" or \"similarity\")");
       }
       if (node.has("matrix")) {
         const JsonNode rows = node["matrix"];
@@ -146,7 +150,8 @@ void read_gluings(const JsonNode& root, Scene& scene) {
       const EdgeRef e = side == 0 ? gl.a : gl.b;
       const int earlier = glued_by[static_cast<size_t>(e.polygon)][static_cast<size_t>(e.edge)];
       if (earlier >= 0)
-        edges[side].fail("edge " + format_edge(e) + " is already glued by /gluings/" + std::to_string(earlier));
+        edges[side].fail("edge " + format_edge(e) + " is already glued by /gluings/" +
+                         std::to_string(earlier));
       glued_by[static_cast<size_t>(e.polygon)][static_cast<size_t>(e.edge)] = static_cast<int>(k);
     }
     GluingMapResult derived = derive_gluing_map(scene, gl.a, gl.b, gl.map, matrix);
@@ -169,10 +174,12 @@ void read_boundaries(const JsonNode& root, Scene& scene) {
     const EdgeRef e = read_edge_ref(node["edge"], scene);
     Edge& edge = scene.polygons[static_cast<size_t>(e.polygon)].edges[static_cast<size_t>(e.edge)];
     if (edge.kind == EdgeKind::glued)
-      node["edge"].fail("edge " + format_edge(e) + " is glued by /gluings/" + std::to_string(edge.gluing) +
-                        "; only unglued edges take a boundary");
+      node["edge"].fail("edge " + format_edge(e) + " is glued by /gluings/" +
+                        std::to_string(edge.gluing) + "; only unglued edges take a boundary");
     for (auto [other, at] : seen)
-      if (other == e) node["edge"].fail("edge " + format_edge(e) + " already has a boundary at /boundaries/" + std::to_string(at));
+      if (other == e)
+        node["edge"].fail("edge " + format_edge(e) + " already has a boundary at /boundaries/" +
+                          std::to_string(at));
     seen.push_back({e, k});
     edge.kind = read_boundary(node["boundary"]);
   }
@@ -193,8 +200,9 @@ void read_objects(const JsonNode& root, Scene& scene) {
       o.size = node["size"].positive();
       o.hole = node.has("hole") ? node["hole"].positive() : 1.3 * o.size;
       if (o.hole >= std::sqrt(3.0) * o.size)
-        node["hole" ].fail("the hole (radius " + format_number(o.hole) + ") removes the whole cube (half-size " +
-                          format_number(o.size) + "); it needs hole < size * sqrt(3)");
+        node["hole"].fail("the hole (radius " + format_number(o.hole) +
+                          ") removes the whole cube (half-size " + format_number(o.size) +
+                          "); it needs hole < size * sqrt(3)");
     } else if (type == "sphere") {
       node.allow_keys({"type", "polygon", "center", "color", "radius"});
       o.type = ObjectType::sphere;
@@ -204,7 +212,8 @@ void read_objects(const JsonNode& root, Scene& scene) {
       o.type = ObjectType::box;
       o.half = node["half"].vec3();
       for (int i = 0; i < 3; ++i)
-        if (!(o.half[i] > 0.0)) node["half"][static_cast<size_t>(i)].fail("box half-extents must be positive");
+        if (!(o.half[i] > 0.0))
+          node["half"][static_cast<size_t>(i)].fail("box half-extents must be positive");
     } else if (type == "cylinder") {
       node.allow_keys({"type", "polygon", "center", "color", "radius", "z"});
       o.type = ObjectType::cylinder;
@@ -218,9 +227,12 @@ void read_objects(const JsonNode& root, Scene& scene) {
         o.z1 = z.y;
       }
     } else {
-      node["type"].fail("unknown object type \"" + type + "\" (expected hollow_cube, sphere, box or cylinder)");
+      node["type"].fail("unknown object type \"" + type +
+                        "\" (expected hollow_cube, sphere, box or cylinder)");
     }
-    o.polygon = node.has("polygon") ? node["polygon"].index(static_cast<int>(scene.polygons.size()), "polygon") : 0;
+    o.polygon = node.has("polygon")
+                    ? node["polygon"].index(static_cast<int>(scene.polygons.size()), "polygon")
+                    : 0;
     o.center = node["center"].vec3();
     if (node.has("color")) o.color = node["color"].color();
     if (type == "cylinder") o.center.z = 0.5 * (o.z0 + o.z1);
@@ -233,14 +245,15 @@ void read_objects(const JsonNode& root, Scene& scene) {
     for (int i = 0; i < polygon.size(); ++i) {
       const double d = distance_to_segment(c, polygon.vertex(i), polygon.vertex(i + 1));
       if (d <= o.footprint_radius())
-        node.fail("the " + where + " reaches edge " + std::to_string(i) + ": its footprint radius " +
-                  format_number(o.footprint_radius()) + " is not less than its distance " +
-                  format_number(d) + " from that edge; objects lie strictly inside their polygon");
+        node.fail("the " + where + " reaches edge " + std::to_string(i) +
+                  ": its footprint radius " + format_number(o.footprint_radius()) +
+                  " is not less than its distance " + format_number(d) +
+                  " from that edge; objects lie strictly inside their polygon");
     }
     if (o.z_min() < 0.0 || o.z_max() > top)
       node.fail("the " + where + " spans z from " + format_number(o.z_min()) + " to " +
-                format_number(o.z_max()) + ", outside the " + (scene.period ? "period" : "wall band") +
-                " [0, " + format_number(top) + "]");
+                format_number(o.z_max()) + ", outside the " +
+                (scene.period ? "period" : "wall band") + " [0, " + format_number(top) + "]");
     scene.objects.push_back(o);
   }
 }
@@ -273,13 +286,14 @@ void read_markers(const JsonNode& root, Scene& scene) {
       const int n = polygon.size();
       for (int i = 0; i < n; ++i) {
         const bool incident = i == k.vertex || (i + 1) % n == k.vertex;
-        const double room = incident ? 0.5 * polygon.edges[static_cast<size_t>(i)].length
-                                     : distance_to_segment(at, polygon.vertex(i), polygon.vertex(i + 1));
+        const double room = incident
+                                ? 0.5 * polygon.edges[static_cast<size_t>(i)].length
+                                : distance_to_segment(at, polygon.vertex(i), polygon.vertex(i + 1));
         if (r >= room)
-          node.fail("radius " + format_number(r) + " is too large: around vertex " + std::to_string(k.vertex) +
-                    " of polygon " + std::to_string(k.polygon) + " the cylinder would reach " +
-                    (incident ? "the middle of edge " : "edge ") + std::to_string(i) + " (room " +
-                    format_number(room) + ")");
+          node.fail("radius " + format_number(r) + " is too large: around vertex " +
+                    std::to_string(k.vertex) + " of polygon " + std::to_string(k.polygon) +
+                    " the cylinder would reach " + (incident ? "the middle of edge " : "edge ") +
+                    std::to_string(i) + " (room " + format_number(room) + ")");
       }
     }
     scene.markers.push_back({static_cast<int>(c), r});
@@ -291,7 +305,8 @@ void read_camera(const JsonNode& root, Scene& scene) {
   const JsonNode node = root.has("camera") ? root["camera"] : root;
   if (root.has("camera")) {
     node.allow_keys({"polygon", "position", "yaw_deg", "pitch_deg", "fov_deg"});
-    if (node.has("polygon")) cam.polygon = node["polygon"].index(static_cast<int>(scene.polygons.size()), "polygon");
+    if (node.has("polygon"))
+      cam.polygon = node["polygon"].index(static_cast<int>(scene.polygons.size()), "polygon");
     if (node.has("yaw_deg")) cam.yaw_deg = node["yaw_deg"].number();
     if (node.has("pitch_deg")) {
       cam.pitch_deg = node["pitch_deg"].number();
@@ -299,7 +314,8 @@ void read_camera(const JsonNode& root, Scene& scene) {
     }
     if (node.has("fov_deg")) {
       cam.fov_deg = node["fov_deg"].number();
-      if (!(cam.fov_deg > 0.0 && cam.fov_deg < 180.0)) node["fov_deg"].fail("the field of view lies in (0, 180) degrees");
+      if (!(cam.fov_deg > 0.0 && cam.fov_deg < 180.0))
+        node["fov_deg"].fail("the field of view lies in (0, 180) degrees");
     }
   }
   const Polygon& polygon = scene.polygons[static_cast<size_t>(cam.polygon)];
@@ -322,7 +338,8 @@ void read_look(const JsonNode& root, Scene& scene) {
   node.allow_keys({"wall_tint", "fog", "background"});
   if (node.has("wall_tint")) {
     scene.look.wall_tint = node["wall_tint"].number();
-    if (scene.look.wall_tint < 0.0 || scene.look.wall_tint > 1.0) node["wall_tint"].fail("wall_tint lies in [0, 1]");
+    if (scene.look.wall_tint < 0.0 || scene.look.wall_tint > 1.0)
+      node["wall_tint"].fail("wall_tint lies in [0, 1]");
   }
   if (node.has("fog")) scene.look.fog = node["fog"].color();
   if (node.has("background")) scene.look.background = node["background"].color();
@@ -332,17 +349,20 @@ void read_look(const JsonNode& root, Scene& scene) {
 
 Scene scene_from_json(const nlohmann::json& doc, const std::string& file) {
   const JsonNode root(doc, "", file);
-  root.allow_keys({"name", "description", "polygons", "gluings", "boundary", "boundaries", "height", "period",
-                   "floor", "objects", "singularities", "vertices", "camera", "look"});
+  root.allow_keys({"name", "description", "polygons", "gluings", "boundary", "boundaries", "height",
+                   "period", "floor", "objects", "singularities", "vertices", "camera", "look"});
   Scene scene;
-  scene.name = root.has("name") ? root["name"].string() : std::filesystem::path(file).stem().string();
+  scene.name =
+      root.has("name") ? root["name"].string() : std::filesystem::path(file).stem().string();
   if (root.has("description")) scene.description = root["description"].string();
   if (root.has("height")) scene.height = root["height"].positive();
   if (root.has("period")) scene.period = root["period"].positive();
   if (root.has("floor")) scene.floor = root["floor"].boolean();
-  if (scene.floor && scene.period) root["floor"].fail("a translation prism (\"period\") has no floor");
+  if (scene.floor && scene.period)
+    root["floor"].fail("a translation prism (\"period\") has no floor");
 
-  read_polygons(root, scene, root.has("boundary") ? read_boundary(root["boundary"]) : EdgeKind::mirror);
+  read_polygons(root, scene,
+                root.has("boundary") ? read_boundary(root["boundary"]) : EdgeKind::mirror);
   read_gluings(root, scene);
   read_boundaries(root, scene);
   derive_vertex_classes(scene);
@@ -356,15 +376,19 @@ Scene scene_from_json(const nlohmann::json& doc, const std::string& file) {
 
 Scene parse_scene(std::string_view text, const std::string& file) {
   if (text.size() > SceneLimits::max_file_bytes)
-    throw SceneError(file, "/", "the file is larger than " + std::to_string(SceneLimits::max_file_bytes >> 20) + " MiB");
-  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos) throw SceneError(file, "/", "the file is empty");
+    throw SceneError(
+        file, "/",
+        "the file is larger than " + std::to_string(SceneLimits::max_file_bytes >> 20) + " MiB");
+  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
+    throw SceneError(file, "/", "the file is empty");
   check_depth(text, file);
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     std::string msg = e.what();
-    if (const size_t end = msg.find("] "); msg.starts_with("[json.exception") && end != std::string::npos)
+    if (const size_t end = msg.find("] ");
+        msg.starts_with("[json.exception") && end != std::string::npos)
       msg = msg.substr(end + 2);
     throw SceneError(file, "/", "invalid JSON: " + msg);
   }
@@ -374,7 +398,8 @@ Scene parse_scene(std::string_view text, const std::string& file) {
 Scene load_scene(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw SceneError(file, "/", "is a directory, not a scene file");
+  if (std::filesystem::is_directory(path, ec))
+    throw SceneError(file, "/", "is a directory, not a scene file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(file, "/", "cannot open the file");
   std::string text;
@@ -382,7 +407,9 @@ Scene load_scene(const std::filesystem::path& path) {
   while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
     text.append(buffer, static_cast<size_t>(in.gcount()));
     if (text.size() > SceneLimits::max_file_bytes)
-      throw SceneError(file, "/", "the file is larger than " + std::to_string(SceneLimits::max_file_bytes >> 20) + " MiB");
+      throw SceneError(
+          file, "/",
+          "the file is larger than " + std::to_string(SceneLimits::max_file_bytes >> 20) + " MiB");
   }
   return parse_scene(text, file);
 }

@@ -40,7 +40,8 @@ bool Polygon::contains(Vec2 p, double margin) const {
 
 double Polygon::distance_to_boundary(Vec2 p) const {
   double d = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < size(); ++i) d = std::min(d, distance_to_segment(p, vertex(i), vertex(i + 1)));
+  for (int i = 0; i < size(); ++i)
+    d = std::min(d, distance_to_segment(p, vertex(i), vertex(i + 1)));
   return d;
 }
 

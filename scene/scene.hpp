@@ -50,7 +50,9 @@ struct Polygon {
   std::vector<Edge> edges;     // edge i runs from vertex i to vertex i+1 (mod n)
 
   int size() const { return static_cast<int>(vertices.size()); }
-  Vec2 vertex(int i) const { return vertices[static_cast<size_t>(((i % size()) + size()) % size())]; }
+  Vec2 vertex(int i) const {
+    return vertices[static_cast<size_t>(((i % size()) + size()) % size())];
+  }
   double area() const;
   Vec2 centroid() const;
   // Strictly inside, at least `margin` away from every edge.
@@ -66,10 +68,10 @@ struct Object {
   ObjectType type = ObjectType::sphere;
   int polygon = 0;
   Vec3 center{0.0};
-  double size = 0.0;    // hollow_cube: half-size of the cube
-  double hole = 0.0;    // hollow_cube: radius of the removed sphere
-  double radius = 0.0;  // sphere, cylinder
-  Vec3 half{0.0};       // box half-extents
+  double size = 0.0;          // hollow_cube: half-size of the cube
+  double hole = 0.0;          // hollow_cube: radius of the removed sphere
+  double radius = 0.0;        // sphere, cylinder
+  Vec3 half{0.0};             // box half-extents
   double z0 = 0.0, z1 = 0.0;  // cylinder extent in z
   std::optional<Vec3> color;
 

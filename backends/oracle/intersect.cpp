@@ -110,10 +110,13 @@ std::optional<SolidHit> intersect(const Object& object, Vec3 o, Vec3 d, double t
                                   double lift) {
   const Vec3 c = object.center + Vec3(0.0, 0.0, lift);
   switch (object.type) {
-    case ObjectType::sphere: return first_hit(sphere_span(c, object.radius, o, d), d, t0, t1);
-    case ObjectType::box: return first_hit(box_span(c, object.half, o, d), d, t0, t1);
+    case ObjectType::sphere:
+      return first_hit(sphere_span(c, object.radius, o, d), d, t0, t1);
+    case ObjectType::box:
+      return first_hit(box_span(c, object.half, o, d), d, t0, t1);
     case ObjectType::cylinder:
-      return intersect_cylinder(Vec2(c), object.radius, object.z0 + lift, object.z1 + lift, o, d, t0, t1);
+      return intersect_cylinder(Vec2(c), object.radius, object.z0 + lift, object.z1 + lift, o, d,
+                                t0, t1);
     case ObjectType::hollow_cube: {
       // CSG difference: the cube's span minus the open span of the sphere, which leaves at most
       // two pieces, before and after the hole.

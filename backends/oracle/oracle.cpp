@@ -75,26 +75,30 @@ ObjectMeet find_object(const Scene& scene, int p, Vec3 o, Vec3 d, double limit) 
   };
   for (size_t k = 0; k < scene.objects.size(); ++k)
     if (scene.objects[k].polygon == p)
-      consider(intersect(scene.objects[k], o, d, 0.0, std::min(limit, meet.t)), static_cast<int>(k));
+      consider(intersect(scene.objects[k], o, d, 0.0, std::min(limit, meet.t)),
+               static_cast<int>(k));
   if (!scene.markers.empty()) {
     const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
     const double top = scene.period ? *scene.period : scene.height;
     for (int v = 0; v < polygon.size(); ++v) {
       const int m = scene.marker_at(p, v);
       if (m < 0) continue;
-      consider(intersect_cylinder(polygon.vertex(v), scene.markers[static_cast<size_t>(m)].radius, 0.0, top, o,
-                                  d, 0.0, std::min(limit, meet.t)),
+      consider(intersect_cylinder(polygon.vertex(v), scene.markers[static_cast<size_t>(m)].radius,
+                                  0.0, top, o, d, 0.0, std::min(limit, meet.t)),
                static_cast<int>(scene.objects.size()) + m);
     }
   }
   return meet;
 }
 
-double wrap(double z, double period) { return z - period * std::floor(z / period); }
+double wrap(double z, double period) {
+  return z - period * std::floor(z / period);
+}
 
 class Tracer {
  public:
-  Tracer(const Scene& scene, const MarchParams& params, const OracleOptions& options, OracleResult& out)
+  Tracer(const Scene& scene, const MarchParams& params, const OracleOptions& options,
+         OracleResult& out)
       : scene_(scene), params_(params), options_(options), out_(out) {}
 
   void run(const Ray& ray) {
@@ -155,11 +159,13 @@ class Tracer {
     if (d_.z < 0.0) band = -o_.z / d_.z;
     const double remaining = params_.max_distance - t_;
 
-    const ObjectMeet object = find_object(scene_, p_, o_, d_, std::min({exit.t, vertex.t, band, remaining}));
+    const ObjectMeet object =
+        find_object(scene_, p_, o_, d_, std::min({exit.t, vertex.t, band, remaining}));
     // Ties go to the object, then the vertex, then the band, then the edge.
     const double first = std::min({object.t, vertex.t, band, exit.t});
     if (first > remaining) return finish(EventKind::max_distance, kHitMaxDistance, remaining, -1);
-    if (object.t == first) return finish(EventKind::object, object.index, object.t, -1, object.normal);
+    if (object.t == first)
+      return finish(EventKind::object, object.index, object.t, -1, object.normal);
     if (vertex.t == first) return finish(EventKind::vertex, kHitVertex, vertex.t, -1);
     if (band == first) {
       if (scene_.period) {  // z is taken modulo the period
@@ -167,17 +173,24 @@ class Tracer {
         o_.z = d_.z > 0.0 ? 0.0 : *scene_.period;
         return false;
       }
-      if (d_.z < 0.0 && scene_.floor) return finish(EventKind::floor, kHitFloor, band, -1, Vec3(0, 0, 1));
+      if (d_.z < 0.0 && scene_.floor)
+        return finish(EventKind::floor, kHitFloor, band, -1, Vec3(0, 0, 1));
       return finish(EventKind::escape, kHitEscape, band, -1);
     }
-    if (exit.edge < 0) return finish(EventKind::vertex, kHitVertex, 0.0, -1);  // numerically cornered
+    if (exit.edge < 0)
+      return finish(EventKind::vertex, kHitVertex, 0.0, -1);  // numerically cornered
 
     const Edge& edge = polygon.edges[static_cast<size_t>(exit.edge)];
     const Vec3 at = o_ + exit.t * d_;
     switch (edge.kind) {
-      case EdgeKind::wall: return finish(EventKind::wall, kHitWall, exit.t, exit.edge, Vec3(-edge.normal, 0.0));
+      case EdgeKind::wall:
+        return finish(EventKind::wall, kHitWall, exit.t, exit.edge, Vec3(-edge.normal, 0.0));
       case EdgeKind::mirror: {
-        record({.kind = EventKind::mirror, .polygon = p_, .edge = exit.edge, .t = t_ + exit.t, .at = at});
+        record({.kind = EventKind::mirror,
+                .polygon = p_,
+                .edge = exit.edge,
+                .t = t_ + exit.t,
+                .at = at});
         advance(exit.t);
         const Vec2 reflected = dh - 2.0 * glm::dot(dh, edge.normal) * edge.normal;
         d_ = glm::normalize(Vec3(reflected, d_.z));
@@ -218,7 +231,12 @@ class Tracer {
     end.polygon = p_;
     end.at = o_;
     end.normal = normal;
-    record({.kind = kind, .polygon = p_, .edge = edge, .object = hit >= 0 ? hit : -1, .t = t_, .at = o_});
+    record({.kind = kind,
+            .polygon = p_,
+            .edge = edge,
+            .object = hit >= 0 ? hit : -1,
+            .t = t_,
+            .at = o_});
     return true;
   }
 
@@ -229,7 +247,8 @@ class Tracer {
   }
 
   void record(const Event& e) {
-    if (static_cast<int>(out_.trace.events.size()) < options_.max_events) out_.trace.events.push_back(e);
+    if (static_cast<int>(out_.trace.events.size()) < options_.max_events)
+      out_.trace.events.push_back(e);
   }
 
   void add_path(Vec3 to) {
@@ -248,13 +267,17 @@ class Tracer {
 }  // namespace
 
 std::optional<std::string> ray_problem(const Scene& scene, const Ray& ray) {
-  const auto finite = [](Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  const auto finite = [](Vec3 v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
   if (!finite(ray.from)) return "the ray's origin is not finite";
-  if (!finite(ray.dir) || glm::length(ray.dir) == 0.0) return "the ray's direction is zero or not finite";
+  if (!finite(ray.dir) || glm::length(ray.dir) == 0.0)
+    return "the ray's direction is zero or not finite";
   if (ray.polygon < 0 || ray.polygon >= static_cast<int>(scene.polygons.size()))
     return "polygon " + std::to_string(ray.polygon) + " does not exist (the scene has " +
            std::to_string(scene.polygons.size()) + ")";
-  if (scene.in_band(ray.from.z) && !scene.polygons[static_cast<size_t>(ray.polygon)].contains(Vec2(ray.from))) {
+  if (scene.in_band(ray.from.z) &&
+      !scene.polygons[static_cast<size_t>(ray.polygon)].contains(Vec2(ray.from))) {
     std::ostringstream s;
     s << "the origin (" << ray.from.x << ", " << ray.from.y << ", " << ray.from.z
       << ") is within the wall band but not strictly inside polygon " << ray.polygon;
@@ -273,10 +296,11 @@ OracleResult oracle_trace(const Scene& scene, const Ray& ray, const MarchParams&
 
 Vec3 oracle_color(const Scene& scene, const RayEnd& end) {
   const Vec3* color = nullptr;
-  if (end.hit >= 0 && end.hit < static_cast<int>(scene.objects.size()) && scene.objects[static_cast<size_t>(end.hit)].color)
+  if (end.hit >= 0 && end.hit < static_cast<int>(scene.objects.size()) &&
+      scene.objects[static_cast<size_t>(end.hit)].color)
     color = &*scene.objects[static_cast<size_t>(end.hit)].color;
-  return shade<double>(end.hit, end.crossings, end.normal, end.at, color, scene.look.wall_tint, scene.look.fog,
-                       scene.look.background);
+  return shade<double>(end.hit, end.crossings, end.normal, end.at, color, scene.look.wall_tint,
+                       scene.look.fog, scene.look.background);
 }
 
 std::string OracleBackend::description() const {
@@ -286,7 +310,8 @@ std::string OracleBackend::description() const {
 Frame OracleBackend::render(const Scene& scene, const Camera& camera, int width, int height,
                             const MarchParams& params, const Progress& progress) const {
   Frame frame(width, height);
-  const CameraBasis<double> basis = camera_basis(camera.yaw_deg, camera.pitch_deg, camera.fov_deg, width, height);
+  const CameraBasis<double> basis =
+      camera_basis(camera.yaw_deg, camera.pitch_deg, camera.fov_deg, width, height);
   constexpr int kRowsPerReport = 16;  // rows rendered in parallel between progress reports
   for (int band = 0; band < height; band += kRowsPerReport) {
     tbb::parallel_for(band, std::min(band + kRowsPerReport, height), [&](int j) {
@@ -295,7 +320,8 @@ Frame OracleBackend::render(const Scene& scene, const Camera& camera, int width,
         const RayEnd end = oracle_trace(scene, ray, params).end;
         const size_t px = frame.pixel(i, j);
         const Vec3 c = oracle_color(scene, end);
-        for (int k = 0; k < 3; ++k) frame.rgb[3 * px + static_cast<size_t>(k)] = static_cast<float>(c[k]);
+        for (int k = 0; k < 3; ++k)
+          frame.rgb[3 * px + static_cast<size_t>(k)] = static_cast<float>(c[k]);
         frame.steps[px] = static_cast<float>(end.steps);
         frame.crossings[px] = static_cast<float>(end.crossings);
         frame.hit[px] = static_cast<float>(end.hit);
@@ -307,7 +333,8 @@ Frame OracleBackend::render(const Scene& scene, const Camera& camera, int width,
   return frame;
 }
 
-Trace OracleBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params, int max_events) const {
+Trace OracleBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+                           int max_events) const {
   return oracle_trace(scene, ray, params, {.max_events = max_events}).trace;
 }
 

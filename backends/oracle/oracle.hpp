@@ -32,8 +32,8 @@ struct PathSegment {
 };
 
 struct OracleOptions {
-  int max_events = 0;         // events to record in `trace`
-  bool record_path = false;   // fill `path`
+  int max_events = 0;        // events to record in `trace`
+  bool record_path = false;  // fill `path`
 };
 
 struct OracleResult {

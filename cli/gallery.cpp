@@ -1,0 +1,150 @@
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "cli/commands.hpp"
+#include "cli/common.hpp"
+#include "output/image_io.hpp"
+#include "scene/load.hpp"
+
+namespace flatmarch::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+// "6π", "3π/2" or radians: how a cone angle reads in the index.
+std::string angle_text(double angle) {
+  for (int den = 1; den <= 12; ++den) {
+    const double num = angle / kPi * den;
+    if (std::abs(num - std::round(num)) < 1e-9) {
+      const long n = std::lround(num);
+      return (n == 1 ? "" : std::to_string(n)) + "π" + (den == 1 ? "" : "/" + std::to_string(den));
+    }
+  }
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f rad", angle);
+  return buf;
+}
+
+std::string surface_summary(const Scene& scene) {
+  const Topology& t = scene.topology;
+  std::string s = "χ = " + std::to_string(t.euler_characteristic) +
+                  (t.orientable ? ", orientable" : ", non-orientable");
+  if (t.genus) s += ", genus " + std::to_string(*t.genus);
+  if (t.boundary_components)
+    s += ", " + std::to_string(t.boundary_components) + " boundary component(s)";
+  std::string cones;
+  for (const VertexClass& vc : scene.vertex_classes)
+    if (vc.singular)
+      cones += (cones.empty() ? "" : ", ") + angle_text(vc.cone_angle) +
+               (vc.boundary ? " (boundary)" : "");
+  s += cones.empty() ? "; no cone points" : "; cone points: " + cones;
+  if (scene.period) s += "; translation prism";
+  return s;
+}
+
+}  // namespace
+
+void add_gallery(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "gallery",
+      "Render every scene of a folder with the oracle into OUT: for each scene NAME.png (colour),\n"
+      "NAME.exr (AOVs), and an index.html that shows them all with their derived structure.");
+  struct Options {
+    std::string scenes = "scenes", out = "out/gallery", size = "960x540";
+    bool quiet = false;
+    MarchOptions march;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("SCENES", o->scenes, "Folder of scene files (*.json)")->capture_default_str();
+  cmd->add_option("-o,--output", o->out, "Output folder (created)")->capture_default_str();
+  cmd->add_option("--size", o->size, "Image size WxH")->capture_default_str();
+  cmd->add_flag("-q,--quiet", o->quiet, "Only errors on stderr");
+  o->march.add_to(*cmd);
+  cmd->callback([o] {
+    const auto [w, h] = parse_size("--size", o->size);
+    const Backend& backend = o->march.resolve();
+    std::error_code ec;
+    if (!fs::is_directory(o->scenes, ec))
+      throw UsageError("SCENES: " + o->scenes + " is not a folder");
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(o->scenes))
+      if (entry.path().extension() == ".json") files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    if (files.empty()) throw UsageError("SCENES: no *.json scene files in " + o->scenes);
+    fs::create_directories(o->out, ec);
+    if (ec) throw UsageError("--output: cannot create " + o->out + ": " + ec.message());
+
+    std::string cards;
+    int failures = 0;
+    for (size_t k = 0; k < files.size(); ++k) {
+      const std::string stem = files[k].stem().string();
+      const std::string label =
+          "[" + std::to_string(k + 1) + "/" + std::to_string(files.size()) + "] " + stem;
+      try {
+        const Scene scene = load_scene(files[k]);
+        const auto start = std::chrono::steady_clock::now();
+        ProgressReporter progress(label, o->quiet);
+        const Frame frame = backend.render(scene, scene.camera, w, h, o->march.params,
+                                           [&](double f) { progress(f); });
+        progress.done();
+        const fs::path png = fs::path(o->out) / (stem + ".png");
+        write_png(frame, png);
+        write_aov_exr(frame, aov_path(png));
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!o->quiet) std::fprintf(stderr, "%s: %.2f s\n", label.c_str(), seconds);
+        cards += "<section><h2>" + html_escape(scene.name) + "</h2><p>" +
+                 html_escape(scene.description) + "</p><p class=\"derived\">" +
+                 html_escape(surface_summary(scene)) + "</p><img src=\"" + stem + ".png\" alt=\"" +
+                 html_escape(scene.name) + "\"></section>\n";
+      } catch (const SceneError& e) {
+        ++failures;
+        std::fprintf(stderr, "%s\n", e.what());
+      }
+    }
+    std::ofstream index(fs::path(o->out) / "index.html");
+    index << "<!doctype html><html><head><meta charset=\"utf-8\"><title>flatmarch "
+             "gallery</title><style>"
+             "body{font-family:sans-serif;max-width:1000px;margin:2em auto;color:#222}"
+             "img{max-width:100%}.derived{color:#555;font-size:90%}</style></head><body>"
+             "<h1>flatmarch gallery</h1><p>Rendered with the "
+          << html_escape(backend.name()) << " backend at " << w << "x" << h << ".</p>\n"
+          << cards << "</body></html>\n";
+    if (!index)
+      throw std::runtime_error("cannot write " + (fs::path(o->out) / "index.html").string());
+    std::fprintf(stderr, "gallery: %zu scenes rendered into %s (open %s/index.html)\n",
+                 files.size() - static_cast<size_t>(failures), o->out.c_str(), o->out.c_str());
+    if (failures)
+      throw UsageError(std::to_string(failures) + " scene(s) failed to load (see above)");
+  });
+}
+
+}  // namespace flatmarch::cli
