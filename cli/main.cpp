@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   cli::add_trace(app);
   cli::add_backends(app);
   cli::add_gallery(app);
+  cli::add_import_peer(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -374,7 +374,7 @@ Scene scene_from_json(const nlohmann::json& doc, const std::string& file) {
   return scene;
 }
 
-Scene parse_scene(std::string_view text, const std::string& file) {
+nlohmann::json parse_json(std::string_view text, const std::string& file) {
   if (text.size() > SceneLimits::max_file_bytes)
     throw SceneError(
         file, "/",
@@ -382,9 +382,8 @@ Scene parse_scene(std::string_view text, const std::string& file) {
   if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
     throw SceneError(file, "/", "the file is empty");
   check_depth(text, file);
-  nlohmann::json doc;
   try {
-    doc = nlohmann::json::parse(text);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     std::string msg = e.what();
     if (const size_t end = msg.find("] ");
@@ -392,14 +391,13 @@ Scene parse_scene(std::string_view text, const std::string& file) {
       msg = msg.substr(end + 2);
     throw SceneError(file, "/", "invalid JSON: " + msg);
   }
-  return scene_from_json(doc, file);
 }
 
-Scene load_scene(const std::filesystem::path& path) {
+nlohmann::json read_json_file(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
-    throw SceneError(file, "/", "is a directory, not a scene file");
+    throw SceneError(file, "/", "is a directory, not a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(file, "/", "cannot open the file");
   std::string text;
@@ -411,7 +409,15 @@ Scene load_scene(const std::filesystem::path& path) {
           file, "/",
           "the file is larger than " + std::to_string(SceneLimits::max_file_bytes >> 20) + " MiB");
   }
-  return parse_scene(text, file);
+  return parse_json(text, file);
+}
+
+Scene parse_scene(std::string_view text, const std::string& file) {
+  return scene_from_json(parse_json(text, file), file);
+}
+
+Scene load_scene(const std::filesystem::path& path) {
+  return scene_from_json(read_json_file(path), path.string());
 }
 
 }  // namespace flatmarch

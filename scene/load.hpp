@@ -38,4 +38,9 @@ Scene load_scene(const std::filesystem::path& path);
 Scene parse_scene(std::string_view text, const std::string& file);
 Scene scene_from_json(const nlohmann::json& doc, const std::string& file);
 
+// The JSON reading under the scene's limits (size, nesting depth), for other JSON inputs too
+// (import-peer): every problem is a SceneError at "/".
+nlohmann::json parse_json(std::string_view text, const std::string& file);
+nlohmann::json read_json_file(const std::filesystem::path& path);
+
 }  // namespace flatmarch

@@ -1,0 +1,48 @@
+// `flatmarch import-peer`: converts a geometry of the original web app (Lander & Taha's
+// RayMarchingFlatSurfaces; format in tests/data/peer-geometries/README.md) into our scene
+// format, and checks the fields that file states but our scenes derive (normals, translation
+// vectors, affine maps) against the maps our loader derives.
+//
+// The app is three.js with y up and the floor plan in (x, z); its walls span y in
+// [-wallHeight, wallHeight]. A point (x, y, z) of the app is (x, z, y + wallHeight) here, in the
+// scene's only polygon, whose height is 2 wallHeight. The floor plan keeps its coordinates (the
+// app's image is therefore the mirror image of ours), a clockwise polygon is reversed.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace flatmarch {
+
+enum class Severity {
+  disagrees,  // a redundant field of the file disagrees with what our loader derives
+  converted,  // converted, but not one to one (say how)
+  moved,      // moved so that it fits our rules
+  dropped,    // cannot be converted: left out
+  ignored,    // a field our scenes have no use for
+};
+
+const char* to_string(Severity severity);
+
+struct PeerFinding {
+  std::string pointer;  // JSON pointer into the peer file ("/" for the document)
+  Severity severity = Severity::converted;
+  std::string message;
+};
+
+struct PeerImport {
+  nlohmann::ordered_json scene;  // a valid scene: scene_from_json accepts it
+  std::vector<PeerFinding> findings;
+};
+
+// A malformed peer file throws SceneError with the JSON pointer into the peer file. `file`
+// names the source in errors and findings; its stem, in snake case, names the scene.
+PeerImport import_peer(const nlohmann::json& peer, const std::string& file);
+PeerImport import_peer_file(const std::filesystem::path& path);
+
+nlohmann::ordered_json findings_json(const std::vector<PeerFinding>& findings);
+
+}  // namespace flatmarch
