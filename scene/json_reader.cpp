@@ -71,13 +71,13 @@ size_t JsonNode::array_size(size_t min_size, size_t max_size) const {
 
 void JsonNode::allow_keys(std::initializer_list<const char*> keys) const {
   object();
-  for (const auto& [key, value] : value_->items()) {
-    const bool known =
-        std::any_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; });
+  for (const auto& item : value_->items()) {
+    const std::string& key = item.key();
+    const bool known = std::any_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; });
     if (!known) {
       std::string list;
       for (const char* k : keys) list += std::string(list.empty() ? "" : ", ") + k;
-      JsonNode{value, pointer_ + "/" + escape_token(key), *file_}.fail(
+      JsonNode{item.value(), pointer_ + "/" + escape_token(key), *file_}.fail(
           "unknown key \"" + key + "\" (expected one of: " + list + ")");
     }
   }

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# The test suite: installs what is missing, builds with warnings as errors and runs every test
+# (ctest); runs the unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer; builds
+# the scene parser fuzzers with clang and runs each for a bounded time. Exits non-zero if any
+# stage fails; ends with the test runner's summary.
+set -uo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+fuzz_seconds=${FLATMARCH_FUZZ_SECONDS:-60}
+
+summaries=()
+failed=0
+stage() {  # stage NAME COMMAND...: runs one stage, records its time and outcome
+  local name=$1 start=$SECONDS rc
+  shift
+  echo "==== $name"
+  "$@"
+  rc=$?
+  summaries+=("$(printf '%-28s %4ds  %s' "$name" $((SECONDS - start)) "$([[ $rc == 0 ]] && echo ok || echo "FAILED ($rc)")")")
+  ((rc == 0)) || failed=1
+  return $rc
+}
+
+ctest_summary=()
+run_ctest() {  # run_ctest BUILD_DIR [ctest arguments...]: keeps ctest's closing summary line
+  local dir=$1 log
+  shift
+  log=$(mktemp)
+  (cd "$dir" && ctest --output-on-failure -j 2 "$@") 2>&1 | tee "$log"
+  local rc=${PIPESTATUS[0]}
+  ctest_summary+=("$dir: $(grep -E 'tests passed|tests failed' "$log" | tail -n 1)")
+  rm -f "$log"
+  return $rc
+}
+
+run_fuzzers() {
+  local dir=build-fuzz corpus rc=0
+  for fuzzer in "$dir"/fuzz/*_fuzzer; do
+    corpus=$(mktemp -d)
+    for seed in scenes/*.json tests/data/*/*.json; do cp "$seed" "$corpus/$(basename "$(dirname "$seed")")-$(basename "$seed")"; done
+    echo "-- $(basename "$fuzzer") for ${fuzz_seconds}s"
+    "$fuzzer" -max_total_time="$fuzz_seconds" -max_len=16384 -timeout=10 -rss_limit_mb=2048 \
+      -print_final_stats=1 "$corpus" 2>&1 | grep -E '^(#|INFO: Running|stat::number_of_executed|==|SUMMARY|ERROR)' | tail -n 8
+    ((PIPESTATUS[0] == 0)) || rc=1
+    rm -rf "$corpus"
+  done
+  return $rc
+}
+
+stage "install dependencies" ci/install-deps.sh || exit 1
+stage "build (-Werror)" ci/build.sh build -DFLATMARCH_WERROR=ON && stage "ctest" run_ctest build
+stage "build (ASan+UBSan)" ci/build.sh build-asan -DFLATMARCH_WERROR=ON -DFLATMARCH_SANITIZE=ON \
+  && stage "ctest -L unit (ASan+UBSan)" run_ctest build-asan -L unit
+stage "build (fuzzers, clang)" env CC=clang CXX=clang++ ci/build.sh build-fuzz -DFLATMARCH_FUZZ=ON \
+  && stage "fuzz (${fuzz_seconds}s each)" run_fuzzers
+
+echo
+echo "==== summary"
+printf '%s\n' "${summaries[@]}"
+if ((failed)); then
+  printf '%s\n' "${ctest_summary[@]}"
+  echo "test.sh: FAILED (see the stages above)"
+  exit 1
+fi
+echo "test.sh: all stages passed"
+printf '%s\n' "${ctest_summary[@]}"
