@@ -1,4 +1,5 @@
 // flatmarch: render flat surfaces by ray marching, and measure renderers against the truth.
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 
@@ -21,6 +22,17 @@ int main(int argc, char** argv) {
   cli::add_backends(app);
   cli::add_gallery(app);
   cli::add_import_peer(app);
+  // CLI11 would only say that a subcommand is required.
+  const auto subcommands = app.get_subcommands([](const CLI::App*) { return true; });
+  const auto known = [&](const char* name) {
+    return std::any_of(subcommands.begin(), subcommands.end(),
+                       [&](const CLI::App* c) { return c->check_name(name); });
+  };
+  if (argc > 1 && argv[1][0] != '-' && !known(argv[1])) {
+    std::fprintf(stderr, "error: unknown command \"%s\"; run `flatmarch --help` for the commands\n",
+                 argv[1]);
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

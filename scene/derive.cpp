@@ -73,10 +73,6 @@ std::optional<PolygonProblem> check_polygon(const Polygon& polygon, double scale
       if (glm::length(polygon.vertex(j) - polygon.vertex(i)) <= tol)
         return PolygonProblem{
             j, "repeats vertex " + std::to_string(i) + " " + format_point(polygon.vertex(i))};
-  const double area = polygon.area();
-  if (std::abs(area) <= tol * scale) return PolygonProblem{-1, "the polygon has zero area"};
-  if (area < 0.0)
-    return PolygonProblem{-1, "the vertices are listed clockwise; list them counterclockwise"};
   for (int i = 0; i < n; ++i) {
     const Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1), c = polygon.vertex(i + 2);
     if (std::abs(side(a, b, c)) <= tol && glm::dot(a - b, c - b) > 0.0)
@@ -92,6 +88,11 @@ std::optional<PolygonProblem> check_polygon(const Polygon& polygon, double scale
         return PolygonProblem{-1, "edges " + std::to_string(i) + " and " + std::to_string(j) +
                                       " intersect: the polygon is not simple"};
     }
+  // Only a simple polygon's signed area says its orientation.
+  const double area = polygon.area();
+  if (std::abs(area) <= tol * scale) return PolygonProblem{-1, "the polygon has zero area"};
+  if (area < 0.0)
+    return PolygonProblem{-1, "the vertices are listed clockwise; list them counterclockwise"};
   return std::nullopt;
 }
 

@@ -1,0 +1,351 @@
+// Every malformed scene and every bad argument ends with one line `error: FILE: /json/path: what
+// is wrong` (arguments: `error: OPTION: ...`) and exit code 2, within a second, never a crash.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "scene/load.hpp"
+#include "tests/process.hpp"
+
+namespace flatmarch {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_flatmarch;
+
+// A valid unit-square room to break one rule at a time.
+constexpr const char* kSquare = R"("polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]]])";
+
+std::string with_square(const std::string& rest) {
+  return std::string("{") + kSquare + (rest.empty() ? "" : ", ") + rest + "}";
+}
+
+struct Case {
+  const char* name;
+  std::string json;
+  const char* pointer;
+  const char* fragment;  // part of the message
+};
+
+std::vector<Case> cases() {
+  const std::string torus_gluings = R"("gluings": [[[0, 0], [0, 2]], [[0, 1], [0, 3]]])";
+  return {
+      // Not a scene at all.
+      {"empty", "", "/", "the file is empty"},
+      {"whitespace", "  \n\t ", "/", "the file is empty"},
+      {"not_json", "polygons: []", "/", "invalid JSON"},
+      {"truncated", R"({"polygons": [[[0, 0], [1, 0])", "/", "invalid JSON"},
+      {"top_level_array", "[1, 2]", "/", "expected an object"},
+      {"nan_literal", R"({"polygons": [[[0, 0], [1, 0], [NaN, 1]]]})", "/", "invalid JSON"},
+      {"infinity_literal", R"({"polygons": [[[0, 0], [1, 0], [Infinity, 1]]]})", "/",
+       "invalid JSON"},
+      {"huge_number", R"({"polygons": [[[0, 0], [1, 0], [1e400, 1]]]})", "/", "invalid JSON"},
+      {"not_utf8", "{\"name\": \"\xff\xfe\", " + std::string(kSquare) + "}", "/", "invalid JSON"},
+      {"deep_nesting", std::string(100000, '[') + std::string(100000, ']'), "/",
+       "nested deeper than 64"},
+      // Structure and types.
+      {"missing_polygons", "{}", "/", "missing required key \"polygons\""},
+      {"no_polygons", R"({"polygons": []})", "/polygons", "at least 1"},
+      {"polygon_not_array", R"({"polygons": ["square"]})", "/polygons/0", "expected an array"},
+      {"two_vertices", R"({"polygons": [[[0, 0], [1, 0]]]})", "/polygons/0", "at least 3"},
+      {"vertex_not_number", R"({"polygons": [[[0, 0], [1, "a"], [0, 1]]]})", "/polygons/0/1/1",
+       "expected a number"},
+      {"vertex_three_coords", R"({"polygons": [[[0, 0], [1, 0, 0], [0, 1]]]})", "/polygons/0/1",
+       "at most 2"},
+      {"unknown_key", with_square(R"("hieght": 3)"), "/hieght", "unknown key \"hieght\""},
+      {"name_not_string", with_square(R"("name": 5)"), "/name", "expected a string"},
+      // Polygons (DESIGN.md section 1).
+      {"clockwise", R"({"polygons": [[[0, 0], [0, 1], [1, 1], [1, 0]]]})", "/polygons/0",
+       "clockwise"},
+      {"collinear_triangle", R"({"polygons": [[[0, 0], [1, 0], [2, 0]]]})", "/polygons/0/2",
+       "fold back"},
+      {"self_intersecting", R"({"polygons": [[[0, 0], [1, 1], [1, 0], [0, 1]]]})", "/polygons/0",
+       "not simple"},
+      {"zero_length_edge", R"({"polygons": [[[0, 0], [1, 0], [1, 0], [0, 1]]]})", "/polygons/0/2",
+       "zero length"},
+      {"repeated_vertex", R"({"polygons": [[[0, 0], [2, 0], [1, 1], [2, 2], [0, 2], [1, 1]]]})",
+       "/polygons/0/5", "repeats vertex 2"},
+      {"fold_back", R"({"polygons": [[[0, 0], [2, 0], [1, 0], [1, 1]]]})", "/polygons/0/1",
+       "fold back"},
+      // Gluings.
+      {"edge_out_of_range", with_square(R"("gluings": [[[0, 0], [0, 4]]])"), "/gluings/0/1/1",
+       "out of range"},
+      {"polygon_out_of_range", with_square(R"("gluings": [[[0, 0], [1, 2]]])"), "/gluings/0/1/0",
+       "out of range"},
+      {"index_not_integer", with_square(R"("gluings": [[[0, 0.5], [0, 2]]])"), "/gluings/0/0/1",
+       "integer"},
+      {"index_negative", with_square(R"("gluings": [[[0, -1], [0, 2]]])"), "/gluings/0/0/1",
+       "out of range"},
+      {"index_huge", with_square(R"("gluings": [[[0, 1)" + std::string(30, '0') + R"(], [0, 2]]])"),
+       "/gluings/0/0/1", "out of range"},
+      {"index_beyond_double",
+       with_square(R"("gluings": [[[0, 1)" + std::string(400, '0') + R"(], [0, 2]]])"), "/",
+       "number overflow"},
+      {"gluing_wrong_arity", with_square(R"("gluings": [[[0, 0]]])"), "/gluings/0", "at least 2"},
+      {"glued_twice", with_square(R"("gluings": [[[0, 0], [0, 2]], [[0, 0], [0, 1]]])"),
+       "/gluings/1/0", "already glued by /gluings/0"},
+      {"glued_to_itself", with_square(R"("gluings": [[[0, 1], [0, 1]]])"), "/gluings/0",
+       "glued to itself"},
+      {"lengths_differ",
+       R"({"polygons": [[[0, 0], [2, 0], [2, 1], [0, 1]]], "gluings": [[[0, 0], [0, 1]]]})",
+       "/gluings/0", "differ in length"},
+      {"unknown_map", with_square(R"("gluings": [{"edges": [[0, 0], [0, 2]], "map": "shear"}])"),
+       "/gluings/0/map", "unknown map"},
+      {"map_and_matrix",
+       with_square(
+           R"("gluings": [{"edges": [[0, 0], [0, 2]], "map": "reflection", "matrix": [[1, 0], [0, 1]]}])"),
+       "/gluings/0", "either \"map\" or \"matrix\""},
+      {"singular_matrix",
+       with_square(R"("gluings": [{"edges": [[0, 0], [0, 2]], "matrix": [[1, 2], [2, 4]]}])"),
+       "/gluings/0", "singular"},
+      {"matrix_misses_edge",
+       with_square(R"("gluings": [{"edges": [[0, 0], [0, 2]], "matrix": [[2, 0], [0, 1]]}])"),
+       "/gluings/0", "does not carry"},
+      {"unknown_gluing_key", with_square(R"("gluings": [{"edges": [[0, 0], [0, 2]], "scale": 2}])"),
+       "/gluings/0/scale", "unknown key"},
+      // Boundaries.
+      {"unknown_boundary", with_square(R"("boundary": "glass")"), "/boundary", "unknown boundary"},
+      {"boundary_on_glued_edge",
+       with_square(torus_gluings + R"(, "boundaries": [{"edge": [0, 0], "boundary": "wall"}])"),
+       "/boundaries/0/edge", "is glued"},
+      {"boundary_twice",
+       with_square(
+           R"("boundaries": [{"edge": [0, 0], "boundary": "wall"}, {"edge": [0, 0], "boundary": "mirror"}])"),
+       "/boundaries/1/edge", "already has a boundary"},
+      // The vertical.
+      {"height_negative", with_square(R"("height": -2)"), "/height", "positive"},
+      {"period_zero", with_square(R"("period": 0)"), "/period", "positive"},
+      {"floor_and_period", with_square(R"("period": 2, "floor": true)"), "/floor", "no floor"},
+      {"floor_not_boolean", with_square(R"("floor": 1)"), "/floor", "true or false"},
+      // Objects.
+      {"unknown_object", with_square(R"("objects": [{"type": "torus", "center": [0.5, 0.5, 1]}])"),
+       "/objects/0/type", "unknown object type"},
+      {"object_missing_center", with_square(R"("objects": [{"type": "sphere", "radius": 0.1}])"),
+       "/objects/0", "missing required key \"center\""},
+      {"object_outside",
+       with_square(R"("objects": [{"type": "sphere", "center": [2, 0.5, 1], "radius": 0.1}])"),
+       "/objects/0/center", "outside that polygon"},
+      {"object_across_edge",
+       with_square(R"("objects": [{"type": "sphere", "center": [0.9, 0.5, 1], "radius": 0.2}])"),
+       "/objects/0", "reaches edge 1"},
+      {"object_above_band",
+       with_square(
+           R"("objects": [{"type": "box", "center": [0.5, 0.5, 1.95], "half": [0.1, 0.1, 0.1]}])"),
+       "/objects/0", "outside the wall band"},
+      {"object_polygon_out_of_range",
+       with_square(
+           R"("objects": [{"type": "sphere", "polygon": 3, "center": [0.5, 0.5, 1], "radius": 0.1}])"),
+       "/objects/0/polygon", "out of range"},
+      {"hole_too_big",
+       with_square(
+           R"("objects": [{"type": "hollow_cube", "center": [0.5, 0.5, 1], "size": 0.1, "hole": 0.2}])"),
+       "/objects/0/hole", "removes the whole cube"},
+      {"box_flat",
+       with_square(
+           R"("objects": [{"type": "box", "center": [0.5, 0.5, 1], "half": [0.1, 0, 0.1]}])"),
+       "/objects/0/half/1", "positive"},
+      {"cylinder_bad_z",
+       with_square(
+           R"("objects": [{"type": "cylinder", "center": [0.5, 0.5, 1], "radius": 0.1, "z": [1, 0.5]}])"),
+       "/objects/0/z", "z0 < z1"},
+      {"sphere_key_of_box",
+       with_square(
+           R"("objects": [{"type": "sphere", "center": [0.5, 0.5, 1], "radius": 0.1, "half": [1, 1, 1]}])"),
+       "/objects/0/half", "unknown key"},
+      // Markers.
+      {"marker_too_large",
+       R"({"polygons": [[[0, 0], [2, 0], [4, 0], [4, 2], [2, 2], [2, 4], [0, 4], [0, 2]]],
+          "gluings": [[[0, 0], [0, 5]], [[0, 1], [0, 3]], [[0, 2], [0, 7]], [[0, 4], [0, 6]]],
+          "singularities": {"radius": 1.5}})",
+       "/singularities/radius", "too large"},
+      // The camera.
+      {"camera_outside", with_square(R"("camera": {"position": [2, 0.5, 1]})"), "/camera/position",
+       "not strictly inside polygon 0"},
+      {"camera_fov", with_square(R"("camera": {"fov_deg": 180})"), "/camera/fov_deg",
+       "field of view"},
+      {"camera_pitch", with_square(R"("camera": {"pitch_deg": 91})"), "/camera/pitch_deg", "pitch"},
+      {"camera_polygon", with_square(R"("camera": {"polygon": 1})"), "/camera/polygon",
+       "out of range"},
+      {"centroid_outside",
+       R"({"polygons": [[[0, 0], [3, 0], [3, 0.2], [0.2, 0.2], [0.2, 2.8], [3, 2.8], [3, 3], [0, 3]]]})",
+       "/", "give camera.position"},
+      // The look.
+      {"wall_tint", with_square(R"("look": {"wall_tint": 1.5})"), "/look/wall_tint", "[0, 1]"},
+      {"fog_colour", with_square(R"("look": {"fog": [0.5, 2, 0.5]})"), "/look/fog/1", "[0, 1]"},
+  };
+}
+
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class MalformedScene : public testing::TestWithParam<Case> {};
+
+TEST_P(MalformedScene, ExitsWith2AndNamesThePointer) {
+  const Case& c = GetParam();
+  const fs::path file = fs::path(test::make_temp_dir()) / (std::string(c.name) + ".json");
+  std::ofstream(file, std::ios::binary) << c.json;
+  const auto r = run_flatmarch({"inspect", file.string()}, 10.0);
+  EXPECT_FALSE(r.timed_out);
+  EXPECT_EQ(r.signal, 0);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.out, "");
+  const std::string prefix = "error: " + file.string() + ": " + c.pointer + ": ";
+  EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  fs::remove_all(file.parent_path());
+}
+
+INSTANTIATE_TEST_SUITE_P(AllRules, MalformedScene, testing::ValuesIn(cases()),
+                         [](const testing::TestParamInfo<Case>& p) {
+                           return std::string(p.param.name);
+                         });
+
+TEST(MalformedScene, MissingFileAndDirectory) {
+  auto r = run_flatmarch({"inspect", "/nonexistent/scene.json"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "error: /nonexistent/scene.json: /: cannot open the file\n");
+  const std::string dir = test::make_temp_dir();
+  r = run_flatmarch({"inspect", dir});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("is a directory"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
+// Hostile documents built in memory are rejected quickly, without exhausting the stack.
+TEST(HostileInput, MillionNestedBracketsAreRejected) {
+  const std::string deep = std::string(1'000'000, '[') + std::string(1'000'000, ']');
+  EXPECT_THROW(parse_scene(deep, "deep.json"), SceneError);
+  const std::string deep_objects = [] {
+    std::string s;
+    for (int i = 0; i < 200000; ++i) s += "{\"a\":";
+    return s + "1" + std::string(200000, '}');
+  }();
+  EXPECT_THROW(parse_scene(deep_objects, "deep.json"), SceneError);
+}
+
+TEST(HostileInput, StringsWithBracketsDoNotCountAsNesting) {
+  const std::string name = std::string(1000, '[');
+  const Scene scene =
+      parse_scene(R"({"name": ")" + name + R"(", )" + std::string(kSquare) + "}", "brackets.json");
+  EXPECT_EQ(scene.name, name);
+}
+
+TEST(HostileInput, TooManyPolygonsIsAnError) {
+  std::string polygons;
+  for (int i = 0; i <= SceneLimits::max_polygons; ++i)
+    polygons += std::string(i ? "," : "") + "[[0,0],[1,0],[0,1]]";
+  try {
+    parse_scene(R"({"polygons": [)" + polygons + "]}", "many.json");
+    FAIL() << "accepted " << SceneLimits::max_polygons + 1 << " polygons";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.pointer(), "/polygons");
+  }
+}
+
+// Bad arguments: exit 2 and one `error:` line naming the option.
+struct ArgCase {
+  const char* name;
+  std::vector<std::string> args;
+  const char* fragment;
+};
+
+void PrintTo(const ArgCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class BadArguments : public testing::TestWithParam<ArgCase> {};
+
+TEST_P(BadArguments, ExitWith2) {
+  const ArgCase& c = GetParam();
+  const std::string dir = test::make_temp_dir();
+  std::vector<std::string> args;
+  for (const std::string& a : c.args) {
+    std::string s = a;
+    if (const size_t at = s.find("@SCENES@"); at != std::string::npos)
+      s.replace(at, 8, FLATMARCH_SOURCE_DIR "/scenes");
+    if (const size_t at = s.find("@OUT@"); at != std::string::npos) s.replace(at, 5, dir);
+    args.push_back(s);
+  }
+  const auto r = run_flatmarch(args, 20.0);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(c.fragment), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(fs::path(dir) / "x.png")) << "a failed command left an output behind";
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cli, BadArguments,
+    testing::Values(
+        ArgCase{"no_command", {}, "subcommand"}, ArgCase{"unknown_command", {"paint"}, "paint"},
+        ArgCase{"size_zero",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--size", "0x5"},
+                "--size"},
+        ArgCase{"size_garbage",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--size", "big"},
+                "--size"},
+        ArgCase{"unknown_backend",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--backend", "cuda"},
+                "unknown backend \"cuda\""},
+        ArgCase{"method_not_run",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--method", "sphere"},
+                "does not run method sphere"},
+        ArgCase{"unknown_method",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--method", "magic"},
+                "unknown method"},
+        ArgCase{"eps_negative",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--eps", "-1"},
+                "--eps"},
+        ArgCase{"eps_not_number",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--eps", "small"},
+                "--eps"},
+        ArgCase{"precision",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--precision", "f16"},
+                "--precision"},
+        ArgCase{"camera_outside",
+                {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--position", "9,9,1"},
+                "not strictly inside polygon 0"},
+        ArgCase{
+            "fov", {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png", "--fov", "0"}, "--fov"},
+        ArgCase{"missing_output", {"render", "@SCENES@/torus.json"}, "--output"},
+        ArgCase{"from_two_numbers",
+                {"trace", "@SCENES@/torus.json", "--from", "1,2", "--dir", "1,0,0"},
+                "--from"},
+        ArgCase{"dir_zero",
+                {"trace", "@SCENES@/torus.json", "--from", "1,1,1", "--dir", "0,0,0"},
+                "direction"},
+        ArgCase{"from_outside",
+                {"trace", "@SCENES@/torus.json", "--from", "5,1,1", "--dir", "1,0,0"},
+                "not strictly inside polygon 0"},
+        ArgCase{
+            "trace_polygon",
+            {"trace", "@SCENES@/torus.json", "--from", "1,1,1", "--dir", "1,0,0", "--polygon", "4"},
+            "polygon 4 does not exist"},
+        ArgCase{"max_events",
+                {"trace", "@SCENES@/torus.json", "--from", "1,1,1", "--dir", "1,0,0",
+                 "--max-events", "0"},
+                "--max-events"},
+        ArgCase{"gallery_not_folder",
+                {"gallery", "@SCENES@/torus.json", "-o", "@OUT@"},
+                "not a folder"}),
+    [](const testing::TestParamInfo<ArgCase>& p) { return std::string(p.param.name); });
+
+TEST(Cli, EverySubcommandHasHelp) {
+  for (const char* command : {"inspect", "render", "trace", "backends", "gallery", "import-peer"}) {
+    const auto r = run_flatmarch({command, "--help"});
+    EXPECT_EQ(r.exit_code, 0) << command;
+    EXPECT_NE(r.out.find("Usage: flatmarch " + std::string(command)), std::string::npos)
+        << command << r.out;
+  }
+  const auto r = run_flatmarch({"--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("Subcommands:"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace flatmarch

@@ -1,0 +1,25 @@
+// Runs a program as a child process with a time limit and captures its output, for tests of the
+// command line.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace flatmarch::test {
+
+struct ProcessResult {
+  int exit_code = -1;  // -1 when killed by a signal or timed out
+  int signal = 0;
+  bool timed_out = false;
+  std::string out, err;
+};
+
+ProcessResult run_process(const std::vector<std::string>& argv, double timeout_seconds = 60.0);
+
+// Runs the flatmarch program under test with these arguments.
+ProcessResult run_flatmarch(const std::vector<std::string>& args, double timeout_seconds = 60.0);
+
+// A fresh empty directory under the system's temporary directory.
+std::string make_temp_dir();
+
+}  // namespace flatmarch::test
