@@ -56,20 +56,25 @@ void write_aov_exr(const Frame& frame, const std::filesystem::path& exr) {
 Frame read_aov_exr(const std::filesystem::path& exr) {
   OIIO::ImageBuf buf(exr.string());
   check(buf.read(0, 0, true, OIIO::TypeDesc::FLOAT), buf, exr, "read");
+  // OpenEXR keeps channels sorted by name, so look each one up.
   const OIIO::ImageSpec& spec = buf.spec();
-  if (spec.nchannels != kAovCount)
-    throw std::runtime_error(exr.string() + ": expected 7 AOV channels");
+  int index[kAovCount];
+  for (int k = 0; k < kAovCount; ++k) {
+    index[k] = spec.channelindex(kAovChannels[k]);
+    if (index[k] < 0) throw std::runtime_error(exr.string() + ": no channel " + kAovChannels[k]);
+  }
   Frame frame(spec.width, spec.height);
-  std::vector<float> pixel(kAovCount);
+  std::vector<float> pixel(static_cast<size_t>(spec.nchannels));
   for (int j = 0; j < frame.height; ++j)
     for (int i = 0; i < frame.width; ++i) {
-      buf.getpixel(i, j, pixel.data());
+      buf.getpixel(i, j, pixel.data(), spec.nchannels);
+      const auto channel = [&](int k) { return pixel[static_cast<size_t>(index[k])]; };
       const size_t px = frame.pixel(i, j);
-      for (size_t k = 0; k < 3; ++k) frame.rgb[3 * px + k] = pixel[k];
-      frame.steps[px] = pixel[3];
-      frame.crossings[px] = pixel[4];
-      frame.hit[px] = pixel[5];
-      frame.t[px] = pixel[6];
+      for (int k = 0; k < 3; ++k) frame.rgb[3 * px + static_cast<size_t>(k)] = channel(k);
+      frame.steps[px] = channel(3);
+      frame.crossings[px] = channel(4);
+      frame.hit[px] = channel(5);
+      frame.t[px] = channel(6);
     }
   return frame;
 }

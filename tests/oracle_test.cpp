@@ -1,0 +1,412 @@
+// The oracle against paths worked out by hand: unfolded straight lines in the universal cover,
+// closed mirror orbits, great circles of the cube, exact intersections.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "backends/oracle/intersect.hpp"
+#include "backends/oracle/oracle.hpp"
+#include "kernels/camera.hpp"
+#include "output/image_io.hpp"
+#include "scene/load.hpp"
+#include "tests/process.hpp"
+#include "tests/test_scenes.hpp"
+
+namespace flatmarch {
+namespace {
+
+constexpr double kTol = 1e-9;
+
+Scene load(const std::string& json) {
+  return parse_scene(json, "test.json");
+}
+
+OracleResult trace(const Scene& s, Vec3 from, Vec3 dir, int polygon = 0, MarchParams params = {}) {
+  return oracle_trace(s, Ray{polygon, from, dir}, params,
+                      {.max_events = 1000, .record_path = true});
+}
+
+void expect_near(Vec3 a, Vec3 b, double tol = kTol) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+
+void expect_gluing(const Event& e, int polygon, int edge, int to_polygon, int to_edge, double t,
+                   Vec3 at) {
+  EXPECT_EQ(e.kind, EventKind::gluing);
+  EXPECT_EQ(e.polygon, polygon);
+  EXPECT_EQ(e.edge, edge);
+  EXPECT_EQ(e.to_polygon, to_polygon);
+  EXPECT_EQ(e.to_edge, to_edge);
+  EXPECT_NEAR(e.t, t, kTol);
+  expect_near(e.at, at);
+}
+
+TEST(OracleTransport, TorusRayCrossesTheEdgesOfItsUnfoldedLine) {
+  // From (1, 1) along (3, 1): in the plane the line meets x = 4k at u = (4k - 1)/3 and y = 4m at
+  // u = 4m - 1 (position (1 + 3u, 1 + u), t = u sqrt 10). In order: u = 1, 7/3 (x), 3 (y),
+  // 11/3, 5, 19/3 (x), 7 (y), 23/3 (x); positions reduced mod 4 into the square.
+  const Scene s = load(test::torus_json());
+  const OracleResult r = trace(s, {1, 1, 1}, {3, 1, 0});
+  const double k = std::sqrt(10.0);
+  struct Crossing {
+    double u;
+    int edge;
+    Vec2 at;
+  };
+  const Crossing expected[] = {
+      {1, 1, {4, 2}}, {7.0 / 3, 1, {4, 10.0 / 3}},  {3, 2, {2, 4}}, {11.0 / 3, 1, {4, 2.0 / 3}},
+      {5, 1, {4, 2}}, {19.0 / 3, 1, {4, 10.0 / 3}}, {7, 2, {2, 4}}, {23.0 / 3, 1, {4, 2.0 / 3}}};
+  ASSERT_GE(r.trace.events.size(), 8u);
+  for (size_t i = 0; i < 8; ++i) {
+    const Crossing& c = expected[i];
+    expect_gluing(r.trace.events[i], 0, c.edge, 0, (c.edge + 2) % 4, c.u * k, Vec3(c.at, 1.0));
+  }
+  // Nothing to hit and no way up or down: the ray runs out of distance.
+  EXPECT_EQ(r.trace.events.back().kind, EventKind::max_distance);
+  EXPECT_EQ(r.end.hit, kHitMaxDistance);
+  EXPECT_NEAR(r.end.t, 100.0, kTol);
+}
+
+TEST(OracleTransport, MirrorSquarePathCloses) {
+  // A unit mirror square; from (0.5, 0.25) at 45 degrees the ray bounces off the right, top,
+  // left and bottom walls at (1, .75), (.75, 1), (0, .25), (.25, 0) and is back at its start
+  // point and direction after a path of 2 sqrt 2.
+  const Scene s = load(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]]]})");
+  const OracleResult r = trace(s, {0.5, 0.25, 1}, {1, 1, 0});
+  const double k = std::sqrt(2.0);
+  const struct {
+    int edge;
+    double t;
+    Vec2 at;
+  } bounces[] = {{1, 0.5 * k, {1, 0.75}},
+                 {2, 0.75 * k, {0.75, 1}},
+                 {3, 1.5 * k, {0, 0.25}},
+                 {0, 1.75 * k, {0.25, 0}},
+                 {1, 2.5 * k, {1, 0.75}}};
+  ASSERT_GE(r.trace.events.size(), 5u);
+  for (size_t i = 0; i < 5; ++i) {
+    const Event& e = r.trace.events[i];
+    EXPECT_EQ(e.kind, EventKind::mirror);
+    EXPECT_EQ(e.edge, bounces[i].edge);
+    EXPECT_NEAR(e.t, bounces[i].t, kTol);
+    expect_near(e.at, Vec3(bounces[i].at, 1.0));
+  }
+  // The fourth bounce sends it back through its start: the path passes (0.5, 0.25) heading (1,1).
+  const PathSegment& back = r.path[4];
+  EXPECT_NEAR(back.from.x, 0.25, kTol);
+  EXPECT_NEAR(back.to.x - back.from.x, back.to.y - back.from.y, kTol);
+}
+
+TEST(OracleTransport, CubeBeltIsAClosedGeodesicOfLength4) {
+  // Along +x through the centre face: right face, back face, (translation -4) left face, centre.
+  const Scene s = load(test::cube_json());
+  const OracleResult r = trace(s, {0.5, 0.5, 1}, {1, 0, 0});
+  ASSERT_GE(r.trace.events.size(), 5u);
+  expect_gluing(r.trace.events[0], 0, 1, 1, 3, 0.5, {1, 0.5, 1});
+  expect_gluing(r.trace.events[1], 1, 1, 2, 3, 1.5, {2, 0.5, 1});
+  expect_gluing(r.trace.events[2], 2, 1, 3, 3, 2.5, {3, 0.5, 1});
+  expect_gluing(r.trace.events[3], 3, 1, 0, 3, 3.5, {0, 0.5, 1});
+  expect_gluing(r.trace.events[4], 0, 1, 1, 3, 4.5, {1, 0.5, 1});  // once round: length 4
+}
+
+TEST(OracleTransport, CubeGreatCircleThroughTheTurnedFaces) {
+  // Along +y: top face; its far edge meets the back face's top by a half turn
+  // g(x, y) = (3 - x, 3 - y), so (0.5, 2) lands at (2.5, 1) heading down; the back face's
+  // bottom meets the bottom face's bottom by a half turn, (x, y) -> (3 - x, -1 - y): (2.5, 0)
+  // lands at (0.5, -1) heading up; then up through the bottom face into the centre face.
+  const Scene s = load(test::cube_json());
+  const OracleResult r = trace(s, {0.5, 0.5, 1}, {0, 1, 0});
+  ASSERT_GE(r.trace.events.size(), 5u);
+  expect_gluing(r.trace.events[0], 0, 2, 4, 0, 0.5, {0.5, 1, 1});
+  expect_gluing(r.trace.events[1], 4, 2, 2, 2, 1.5, {0.5, 2, 1});
+  expect_gluing(r.trace.events[2], 2, 0, 5, 0, 2.5, {2.5, 0, 1});
+  expect_gluing(r.trace.events[3], 5, 2, 0, 0, 3.5, {0.5, 0, 1});
+  expect_gluing(r.trace.events[4], 0, 2, 4, 0, 4.5, {0.5, 1, 1});
+  // The path in the back face runs down from (2.5, 1) to (2.5, 0).
+  expect_near(r.path[2].from, {2.5, 1, 1});
+  expect_near(r.path[2].to, {2.5, 0, 1});
+}
+
+TEST(OracleTransport, RotatedGluingTurnsTheDirection) {
+  // In the top face heading +x: its right edge maps by g(x, y) = (y, -x) + (0, 2), so (1, 1.5)
+  // lands at (1.5, 1) on the right face's top and the direction (1, 0) turns into (0, -1): the
+  // ray then crosses the right face downwards to (1.5, 0) on its bottom edge.
+  const Scene s = load(test::cube_json());
+  const OracleResult r = trace(s, {0.5, 1.5, 1}, {1, 0, 0}, 4);
+  ASSERT_GE(r.trace.events.size(), 2u);
+  expect_gluing(r.trace.events[0], 4, 1, 1, 2, 0.5, {1, 1.5, 1});
+  expect_gluing(r.trace.events[1], 1, 0, 5, 1, 1.5, {1.5, 0, 1});
+  expect_near(r.path[1].from, {1.5, 1, 1});
+}
+
+TEST(OracleTransport, RayThroughAVertexEndsThere) {
+  // From (1, 1) along (1, 1) the ray meets the corner (4, 4) at t = 3 sqrt 2.
+  const Scene s = load(test::torus_json());
+  const OracleResult r = trace(s, {1, 1, 1}, {1, 1, 0});
+  ASSERT_EQ(r.trace.events.size(), 1u);
+  EXPECT_EQ(r.trace.events[0].kind, EventKind::vertex);
+  EXPECT_NEAR(r.trace.events[0].t, 3 * std::sqrt(2.0), kTol);
+  EXPECT_EQ(r.end.hit, kHitVertex);
+  // 1e-9 above that line it passes 7e-10 from the corner, so it crosses the top edge first
+  // (at x = 4 - 1e-9) and goes on.
+  const OracleResult near_miss = trace(s, {1, 1 + 1e-9, 1}, {1, 1, 0});
+  ASSERT_GE(near_miss.trace.events.size(), 2u);
+  EXPECT_EQ(near_miss.trace.events[0].kind, EventKind::gluing);
+  EXPECT_EQ(near_miss.trace.events[0].edge, 2);
+  EXPECT_NEAR(near_miss.trace.events[0].at.x, 4 - 1e-9, 1e-12);
+}
+
+TEST(OracleTransport, EscapeFloorAndPeriod) {
+  // Rising at slope 4/3 from z = 1, the ray leaves the band (height 2) at t = 1 / 0.8.
+  const Scene torus = load(test::torus_json());
+  OracleResult r = trace(torus, {1, 1, 1}, {0.6, 0, 0.8});
+  ASSERT_EQ(r.trace.events.size(), 1u);
+  EXPECT_EQ(r.trace.events[0].kind, EventKind::escape);
+  EXPECT_NEAR(r.end.t, 1.25, kTol);
+  expect_near(r.end.at, {1.75, 1, 2});
+  EXPECT_EQ(r.end.hit, kHitEscape);
+  // Falling onto a floor instead.
+  const Scene floored = load(test::torus_json(R"("floor": true)"));
+  r = trace(floored, {1, 1, 1}, {0.6, 0, -0.8});
+  EXPECT_EQ(r.end.hit, kHitFloor);
+  expect_near(r.end.at, {1.75, 1, 0});
+  // In a translation prism of period 2 a ray going straight up from z = 1.5 wraps at z = 2
+  // (t = 0.5) to z = 0 and meets the sphere (centre z = 1, radius 0.2) at z = 0.8: t = 1.3.
+  const Scene prism = load(test::torus_json(
+      R"("period": 2, "objects": [{"type": "sphere", "center": [2, 2, 1], "radius": 0.2}])"));
+  r = trace(prism, {2, 2, 1.5}, {0, 0, 1});
+  EXPECT_EQ(r.end.hit, 0);
+  EXPECT_NEAR(r.end.t, 1.3, kTol);
+  expect_near(r.end.at, {2, 2, 0.8});
+  EXPECT_EQ(r.end.steps, 2);
+  EXPECT_EQ(r.end.crossings, 0);  // wrapping in z is not a wall crossing
+}
+
+TEST(OracleTransport, SphereHitAfterThreeGluings) {
+  // A sphere of radius 0.5 at (2, 2, 1) in the torus has copies at (2 + 4i, 2 + 4j). From
+  // (1, 2.7) aimed at the copy (10, 6): the line x - 1 = 9s, y - 2.7 = 3.3s passes no other copy
+  // within 1 and no corner; it crosses x = 4, y = 4, x = 8 and hits at |(9, 3.3)| - 0.5.
+  const Scene s = load(
+      test::torus_json(R"("objects": [{"type": "sphere", "center": [2, 2, 1], "radius": 0.5}])"));
+  const Vec3 from{1, 2.7, 1}, dir = glm::normalize(Vec3(9, 3.3, 0));
+  const OracleResult r = trace(s, from, dir);
+  const double t = std::sqrt(81 + 3.3 * 3.3) - 0.5;
+  EXPECT_EQ(r.end.hit, 0);
+  EXPECT_EQ(r.end.crossings, 3);
+  EXPECT_NEAR(r.end.t, t, kTol);
+  const Vec3 cover = from + t * dir;  // the hit point in the plane, reduced by (8, 4)
+  expect_near(r.end.at, cover - Vec3(8, 4, 0));
+  // The normal points from the sphere's centre to the hit point: back along the ray.
+  expect_near(r.end.normal, -dir);
+  ASSERT_EQ(r.trace.events.size(), 4u);
+  EXPECT_EQ(r.trace.events[0].edge, 1);
+  EXPECT_EQ(r.trace.events[1].edge, 2);
+  EXPECT_EQ(r.trace.events[2].edge, 1);
+  EXPECT_EQ(r.trace.events[3].kind, EventKind::object);
+  EXPECT_EQ(r.trace.events[3].object, 0);
+}
+
+TEST(OracleTransport, LimitsEndTheRay) {
+  const Scene s = load(test::torus_json());
+  MarchParams params;
+  params.max_distance = 5;
+  OracleResult r = trace(s, {1, 1, 1}, {1, 0.3, 0}, 0, params);
+  EXPECT_EQ(r.end.hit, kHitMaxDistance);
+  EXPECT_NEAR(r.end.t, 5, kTol);
+  params = {};
+  params.max_steps = 3;
+  r = trace(s, {1, 1, 1}, {1, 0.3, 0}, 0, params);
+  EXPECT_EQ(r.end.hit, kHitMaxSteps);
+  EXPECT_EQ(r.end.steps, 3);
+  ASSERT_EQ(r.trace.events.size(), 4u);  // three gluings, then max_steps
+  EXPECT_EQ(r.trace.events[3].kind, EventKind::max_steps);
+}
+
+TEST(OracleTransport, CameraAboveSeesTheRoomsLaidOut) {
+  // Two rooms side by side; straight down from (5, 1, 5) the ray crosses z = 2 inside the
+  // second one (t = 3), enters it and lands on its floor at t = 5.
+  const Scene s = load(
+      R"({"polygons": [[[0, 0], [2, 0], [2, 2], [0, 2]], [[4, 0], [6, 0], [6, 2], [4, 2]]], "floor": true})");
+  OracleResult r = trace(s, {5, 1, 5}, {0, 0, -1});
+  ASSERT_EQ(r.trace.events.size(), 2u);
+  EXPECT_EQ(r.trace.events[0].kind, EventKind::enter);
+  EXPECT_EQ(r.trace.events[0].polygon, 1);
+  EXPECT_NEAR(r.trace.events[0].t, 3, kTol);
+  EXPECT_EQ(r.end.hit, kHitFloor);
+  EXPECT_NEAR(r.end.t, 5, kTol);
+  // Between the rooms nothing is entered.
+  r = trace(s, {3, 1, 5}, {0, 0, -1});
+  EXPECT_EQ(r.end.hit, kHitMiss);
+  EXPECT_EQ(r.trace.events.back().kind, EventKind::miss);
+  // Looking up from above sees nothing either.
+  EXPECT_EQ(trace(s, {1, 1, 5}, {0, 0, 1}).end.hit, kHitMiss);
+}
+
+TEST(OracleTransport, SimilarityGluingSumsTInEachRoomsMetric) {
+  // The unit square's right edge glued by the similarity g = 2 x to the left edge of [2,4]^2.
+  // Direction (1, 0, 0.5): 0.5 across the first room (t = 0.5 |(1, 0, 0.5)|, z + 0.25); in the
+  // second the horizontal part doubles, direction (2, 0, 0.5) normalised, 2 across it to the
+  // mirror at x = 4 (t = 2 |(2, 0, 0.5)| / 2, z + 0.5).
+  const Scene s =
+      load(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]], [[2, 0], [4, 0], [4, 2], [2, 2]]],
+      "gluings": [{"edges": [[0, 1], [1, 3]], "map": "similarity"}], "height": 3})");
+  const OracleResult r = trace(s, {0.5, 0.5, 1}, {1, 0, 0.5});
+  ASSERT_GE(r.trace.events.size(), 2u);
+  const double t0 = 0.5 * std::sqrt(1.25), t1 = std::sqrt(4.25);
+  expect_gluing(r.trace.events[0], 0, 1, 1, 3, t0, {1, 0.5, 1.25});
+  EXPECT_EQ(r.trace.events[1].kind, EventKind::mirror);
+  EXPECT_NEAR(r.trace.events[1].t, t0 + t1, kTol);
+  expect_near(r.trace.events[1].at, {4, 1, 1.75});
+}
+
+TEST(OracleTransport, WallStopsTheRay) {
+  const Scene s = load(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]]], "boundary": "wall"})");
+  const OracleResult r = trace(s, {0.5, 0.5, 1}, {1, 0, 0});
+  EXPECT_EQ(r.end.hit, kHitWall);
+  EXPECT_NEAR(r.end.t, 0.5, kTol);
+  EXPECT_EQ(r.trace.events[0].edge, 1);
+}
+
+TEST(OracleTransport, ConePointCylinder) {
+  // The L's cone point at its reflex corner (2, 2) drawn as a cylinder of radius 0.1: straight
+  // at it from (1, 1) the ray meets it at sqrt 2 - 0.1; the marker's index follows the objects.
+  const Scene s =
+      load(R"({"polygons": [[[0, 0], [2, 0], [4, 0], [4, 2], [2, 2], [2, 4], [0, 4], [0, 2]]],
+      "gluings": [[[0, 0], [0, 5]], [[0, 1], [0, 3]], [[0, 2], [0, 7]], [[0, 4], [0, 6]]],
+      "objects": [{"type": "sphere", "center": [3, 1, 1], "radius": 0.1}],
+      "singularities": {"radius": 0.1}})");
+  const OracleResult r = trace(s, {1, 1, 1}, {1, 1, 0});
+  EXPECT_EQ(r.end.hit, 1);
+  EXPECT_NEAR(r.end.t, std::sqrt(2.0) - 0.1, kTol);
+  // From (1, 3) towards (0.05, 2) the line passes 0.05 / |(0.95, 1)| = 0.036 from the straight
+  // corner (0, 2), which belongs to the cone point too: it hits that corner's sector.
+  const OracleResult sector = trace(s, {1, 3, 1}, {-0.95, -1, 0});
+  EXPECT_EQ(sector.end.hit, 1);
+}
+
+TEST(Intersect, EachSolidExactly) {
+  Object sphere;
+  sphere.type = ObjectType::sphere;
+  sphere.radius = 1;
+  auto hit = intersect(sphere, {-3, 0, 0}, {1, 0, 0}, 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 2, kTol);
+  expect_near(hit->normal, {-1, 0, 0});
+  EXPECT_FALSE(intersect(sphere, {-3, 1.01, 0}, {1, 0, 0}, 0, 10));
+  EXPECT_FALSE(intersect(sphere, {-3, 0, 0}, {1, 0, 0}, 0, 1.9));  // beyond the segment
+
+  Object box;
+  box.type = ObjectType::box;
+  box.half = {1, 2, 3};
+  hit = intersect(box, {0, -5, 0}, {0, 1, 0}, 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 3, kTol);
+  expect_near(hit->normal, {0, -1, 0});
+  // Diagonally from (-5, -5): x enters at 4 sqrt 2, y at 3 sqrt 2: the x face is hit.
+  hit = intersect(box, {-5, -5, 0}, glm::normalize(Vec3(1, 1, 0)), 0, 20);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 4 * std::sqrt(2.0), kTol);
+  expect_near(hit->normal, {-1, 0, 0});
+
+  // A capped cylinder of radius 1 from z = 0 to 2: its side, its top cap, and its bottom.
+  hit = intersect_cylinder({0, 0}, 1, 0, 2, {-3, 0, 1}, {1, 0, 0}, 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 2, kTol);
+  expect_near(hit->normal, {-1, 0, 0});
+  hit = intersect_cylinder({0, 0}, 1, 0, 2, {0.5, 0, 5}, {0, 0, -1}, 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 3, kTol);
+  expect_near(hit->normal, {0, 0, 1});
+  hit = intersect_cylinder({0, 0}, 1, 0, 2, {0, 0, -1}, {0, 0, 1}, 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 1, kTol);
+  expect_near(hit->normal, {0, 0, -1});
+  // Sloping down from (3, 0, 2.2) along (-1, 0, -0.25): the side x = 1 at u = 2, z = 1.7.
+  const Vec3 slope = glm::normalize(Vec3(-1, 0, -0.25));
+  hit = intersect_cylinder({0, 0}, 1, 0, 2, {3, 0, 2.2}, slope, 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 2 * std::sqrt(1.0625), kTol);
+  expect_near(hit->normal, {1, 0, 0});
+}
+
+TEST(Intersect, HollowCubeIsTheCubeMinusTheSphere) {
+  Object cube;
+  cube.type = ObjectType::hollow_cube;
+  cube.size = 1;    // the cube [-1, 1]^3
+  cube.hole = 1.3;  // cuts a disk of radius sqrt(1.3^2 - 1) = 0.83 out of each face
+  // A face point outside the hole: (-1, 0.95, 0.95) is 1.67 from the centre.
+  auto hit = intersect(cube, {-3, 0.95, 0.95}, {1, 0, 0}, 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, 2, kTol);
+  expect_near(hit->normal, {-1, 0, 0});
+  // Along the axis the whole chord through the cube (x in [-1, 1]) lies inside the hole.
+  EXPECT_FALSE(intersect(cube, {-3, 0, 0}, {1, 0, 0}, 0, 10));
+  // From (-2, 0, 0) along (1, .45, .45): the cube spans u in [1, 20/9]; at u = 1 the face point
+  // (-1, .45, .45) is in the hole (.45^2 + .45^2 < .69); the sphere (u - 2)^2 + 2 (.45 u)^2 =
+  // 1.69 is left at u = (4 + sqrt(16 - 4 * 1.405 * 2.31)) / (2 * 1.405), inside the cube: the ray
+  // hits the cavity's far wall, whose normal points to the centre.
+  const Vec3 d = Vec3(1, 0.45, 0.45);
+  const double u = (4 + std::sqrt(16 - 4 * 1.405 * 2.31)) / (2 * 1.405);
+  hit = intersect(cube, {-2, 0, 0}, glm::normalize(d), 0, 10);
+  ASSERT_TRUE(hit);
+  EXPECT_NEAR(hit->t, u * glm::length(d), kTol);
+  const Vec3 p = Vec3(-2, 0, 0) + u * d;
+  expect_near(hit->normal, -p / 1.3);
+}
+
+TEST(Camera, RaysOfDesignSection2) {
+  // An odd image's centre pixel looks along F.
+  auto c = camera_basis(0.0, 0.0, 90.0, 3, 3);
+  expect_near(camera_ray(c, 1, 1, 3, 3), {1, 0, 0});
+  c = camera_basis(90.0, 0.0, 90.0, 3, 3);
+  expect_near(camera_ray(c, 1, 1, 3, 3), {0, 1, 0});
+  c = camera_basis(0.0, 90.0, 60.0, 3, 3);
+  expect_near(camera_ray(c, 1, 1, 3, 3), {0, 0, 1});
+  // The top-left pixel of 4x2 at fov 90: u = (2 * 0.5 / 4 - 1) * 2 = -1.5, v = 0.5, with
+  // R = (0, -1, 0) and U = (0, 0, 1): normalize(1, 1.5, 0.5) -- up and to the left (+y).
+  c = camera_basis(0.0, 0.0, 90.0, 4, 2);
+  expect_near(camera_ray(c, 0, 0, 4, 2), glm::normalize(Vec3(1, 1.5, 0.5)));
+}
+
+TEST(OracleRender, LookingStraightUpEverythingEscapes) {
+  // From the centre of the 4x4 torus at z = 1 looking up with a 60 degree field of view, every
+  // ray reaches z = 2 within 1 of its start horizontally: one step, no crossing, escape.
+  const Scene s = load(test::torus_json());
+  Camera cam{0, {2, 2, 1}, 0.0, 90.0, 60.0};
+  const Frame f = OracleBackend().render(s, cam, 8, 6, {}, {});
+  const CameraBasis<double> basis = camera_basis(0.0, 90.0, 60.0, 8, 6);
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 8; ++i) {
+      const size_t px = f.pixel(i, j);
+      EXPECT_EQ(f.hit[px], kHitEscape);
+      EXPECT_EQ(f.steps[px], 1);
+      EXPECT_EQ(f.crossings[px], 0);
+      EXPECT_FLOAT_EQ(f.t[px], static_cast<float>(1.0 / camera_ray(basis, i, j, 8, 6).z));
+      for (int k = 0; k < 3; ++k)
+        EXPECT_FLOAT_EQ(f.rgb[3 * px + static_cast<size_t>(k)], 1.0f);  // background
+    }
+}
+
+TEST(OracleRender, AovExrRoundTrip) {
+  const Scene s = load_scene(FLATMARCH_SOURCE_DIR "/scenes/l_shape.json");
+  const Frame f = OracleBackend().render(s, s.camera, 24, 16, {}, {});
+  const std::string dir = test::make_temp_dir();
+  write_aov_exr(f, dir + "/frame.exr");
+  write_png(f, dir + "/frame.png");
+  const Frame back = read_aov_exr(dir + "/frame.exr");
+  ASSERT_EQ(back.width, 24);
+  ASSERT_EQ(back.height, 16);
+  EXPECT_EQ(back.rgb, f.rgb);
+  EXPECT_EQ(back.steps, f.steps);
+  EXPECT_EQ(back.crossings, f.crossings);
+  EXPECT_EQ(back.hit, f.hit);
+  EXPECT_EQ(back.t, f.t);
+  EXPECT_TRUE(std::filesystem::file_size(dir + "/frame.png") > 0);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace flatmarch
