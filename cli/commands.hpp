@@ -10,6 +10,7 @@ void add_render(CLI::App& app);
 void add_trace(CLI::App& app);
 void add_backends(CLI::App& app);
 void add_gallery(CLI::App& app);
+void add_plan(CLI::App& app);
 void add_import_peer(CLI::App& app);
 
 }  // namespace flatmarch::cli

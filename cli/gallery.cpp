@@ -1,13 +1,15 @@
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
+#include "kernels/camera.hpp"
 #include "output/image_io.hpp"
+#include "plan/floor_plan.hpp"
+#include "scene/describe.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::cli {
@@ -39,44 +41,15 @@ std::string html_escape(const std::string& s) {
   return out;
 }
 
-// "6π", "3π/2" or radians: how a cone angle reads in the index.
-std::string angle_text(double angle) {
-  for (int den = 1; den <= 12; ++den) {
-    const double num = angle / kPi * den;
-    if (std::abs(num - std::round(num)) < 1e-9) {
-      const long n = std::lround(num);
-      return (n == 1 ? "" : std::to_string(n)) + "π" + (den == 1 ? "" : "/" + std::to_string(den));
-    }
-  }
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4f rad", angle);
-  return buf;
-}
-
-std::string surface_summary(const Scene& scene) {
-  const Topology& t = scene.topology;
-  std::string s = "χ = " + std::to_string(t.euler_characteristic) +
-                  (t.orientable ? ", orientable" : ", non-orientable");
-  if (t.genus) s += ", genus " + std::to_string(*t.genus);
-  if (t.boundary_components)
-    s += ", " + std::to_string(t.boundary_components) + " boundary component(s)";
-  std::string cones;
-  for (const VertexClass& vc : scene.vertex_classes)
-    if (vc.singular)
-      cones += (cones.empty() ? "" : ", ") + angle_text(vc.cone_angle) +
-               (vc.boundary ? " (boundary)" : "");
-  s += cones.empty() ? "; no cone points" : "; cone points: " + cones;
-  if (scene.period) s += "; translation prism";
-  return s;
-}
-
 }  // namespace
 
 void add_gallery(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "gallery",
       "Render every scene of a folder with the oracle into OUT: for each scene NAME.png (colour),\n"
-      "NAME.exr (AOVs), and an index.html that shows them all with their derived structure.");
+      "NAME.exr (AOVs) and NAME.svg (its floor plan with the ray through the middle of the "
+      "picture),\n"
+      "and an index.html that shows them all with their derived structure.");
   struct Options {
     std::string scenes = "scenes", out = "out/gallery", size = "960x540";
     bool quiet = false;
@@ -118,13 +91,21 @@ void add_gallery(CLI::App& app) {
         const fs::path png = fs::path(o->out) / (stem + ".png");
         write_png(frame, png);
         write_aov_exr(frame, aov_path(png));
+        // The floor plan, with the ray through the middle of the picture.
+        PlanOptions plan;
+        const Camera& cam = scene.camera;
+        plan.ray = Ray{cam.polygon, cam.position,
+                       camera_basis(cam.yaw_deg, cam.pitch_deg, cam.fov_deg, w, h).forward};
+        std::ofstream(fs::path(o->out) / (stem + ".svg"), std::ios::binary)
+            << floor_plan_svg(scene, plan);
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!o->quiet) std::fprintf(stderr, "%s: %.2f s\n", label.c_str(), seconds);
         cards += "<section><h2>" + html_escape(scene.name) + "</h2><p>" +
                  html_escape(scene.description) + "</p><p class=\"derived\">" +
                  html_escape(surface_summary(scene)) + "</p><img src=\"" + stem + ".png\" alt=\"" +
-                 html_escape(scene.name) + "\"></section>\n";
+                 html_escape(scene.name) + "\"><img class=\"plan\" src=\"" + stem +
+                 ".svg\" alt=\"floor plan of " + html_escape(scene.name) + "\"></section>\n";
       } catch (const SceneError& e) {
         ++failures;
         std::fprintf(stderr, "%s\n", e.what());
@@ -134,7 +115,8 @@ void add_gallery(CLI::App& app) {
     index << "<!doctype html><html><head><meta charset=\"utf-8\"><title>flatmarch "
              "gallery</title><style>"
              "body{font-family:sans-serif;max-width:1000px;margin:2em auto;color:#222}"
-             "img{max-width:100%}.derived{color:#555;font-size:90%}</style></head><body>"
+             "img{max-width:100%}.plan{max-width:60%;display:block;margin-top:.5em}.derived{color:#"
+             "555;font-size:90%}</style></head><body>"
              "<h1>flatmarch gallery</h1><p>Rendered with the "
           << html_escape(backend.name()) << " backend at " << w << "x" << h << ".</p>\n"
           << cards << "</body></html>\n";

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   cli::add_render(app);
   cli::add_trace(app);
   cli::add_backends(app);
+  cli::add_plan(app);
   cli::add_gallery(app);
   cli::add_import_peer(app);
   // CLI11 would only say that a subcommand is required.

@@ -1,0 +1,38 @@
+#include "scene/describe.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace flatmarch {
+
+std::string cone_angle_text(double radians) {
+  for (int den = 1; den <= 12; ++den) {
+    const double num = radians / kPi * den;
+    if (std::abs(num - std::round(num)) < 1e-9) {
+      const long n = std::lround(num);
+      return (n == 1 ? "" : std::to_string(n)) + "π" + (den == 1 ? "" : "/" + std::to_string(den));
+    }
+  }
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f rad", radians);
+  return buf;
+}
+
+std::string surface_summary(const Scene& scene) {
+  const Topology& t = scene.topology;
+  std::string s = "χ = " + std::to_string(t.euler_characteristic) +
+                  (t.orientable ? ", orientable" : ", non-orientable");
+  if (t.genus) s += (t.orientable ? ", genus " : ", cross-cap genus ") + std::to_string(*t.genus);
+  if (t.boundary_components)
+    s += ", " + std::to_string(t.boundary_components) + " boundary component(s)";
+  std::string cones;
+  for (const VertexClass& vc : scene.vertex_classes)
+    if (vc.singular)
+      cones += (cones.empty() ? "" : ", ") + cone_angle_text(vc.cone_angle) +
+               (vc.boundary ? " (boundary)" : "");
+  s += cones.empty() ? "; no cone points" : "; cone points: " + cones;
+  if (scene.period) s += "; translation prism";
+  return s;
+}
+
+}  // namespace flatmarch
