@@ -1,0 +1,119 @@
+// Every gallery scene loads with the structure its surface has, worked out from the mathematics,
+// and its camera shows something.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "backends/oracle/oracle.hpp"
+#include "scene/load.hpp"
+
+namespace flatmarch {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Surface {
+  std::vector<double> cone_angles_over_pi;  // of the singular vertex classes, ascending
+  int euler_characteristic;
+  bool orientable;
+  int genus;  // handles, or cross-caps when non-orientable
+  int boundary_components;
+};
+
+// Translation surfaces of genus 2 with one cone point of 6 pi (Gauss-Bonnet: 2 pi - 6 pi =
+// 2 pi chi); their prisms and marked versions have the same floor plan.
+const Surface kGenus2{{6.0}, -2, true, 2, 0};
+const Surface kTorus{{}, 0, true, 1, 0};
+// Mirror rooms are disks (chi = 1, one boundary circle); every corner is a boundary class of
+// its own whose angle is the corner's.
+Surface mirror_room(std::vector<double> corners_over_pi) {
+  std::sort(corners_over_pi.begin(), corners_over_pi.end());
+  return {corners_over_pi, 1, true, 0, 1};
+}
+
+const std::map<std::string, Surface>& expected() {
+  static const std::map<std::string, Surface> table = {
+      {"torus", kTorus},
+      {"torus_prism", kTorus},
+      {"l_shape", kGenus2},
+      {"l_shape_prism", kGenus2},
+      {"l_shape_singularities", kGenus2},
+      {"double_pentagon", kGenus2},
+      {"double_pentagon_prism", kGenus2},
+      {"double_pentagon_singularities", kGenus2},
+      // Eight corners of three right angles each: the sphere, 8 (2 pi - 3 pi / 2) = 4 pi.
+      {"cube", {std::vector<double>(8, 1.5), 2, true, 0, 0}},
+      // Four corners of angle pi: the sphere again.
+      {"pillowcase", {std::vector<double>(4, 1.0), 2, true, 0, 0}},
+      // One regular point, chi = 1 - 2 + 1, two cross-caps.
+      {"klein_bottle", {{}, 0, false, 2, 0}},
+      {"mirror_square", mirror_room({0.5, 0.5, 0.5, 0.5})},
+      {"mirror_pentagon", mirror_room({0.6, 0.6, 0.6, 0.6, 0.6})},
+      // Two pentagons sharing an edge: the shared edge's ends have 2 x 3 pi / 5.
+      {"mirror_double_pentagon", mirror_room({0.6, 0.6, 0.6, 0.6, 0.6, 0.6, 1.2, 1.2})},
+      {"mirror_triangle_1rad", mirror_room({1.0 / kPi, 0.5, 0.5 - 1.0 / kPi})},
+      {"mirror_triangle_30_60_90", mirror_room({1.0 / 6, 1.0 / 3, 0.5})},
+      {"mirror_triangle_equilateral", mirror_room({1.0 / 3, 1.0 / 3, 1.0 / 3})},
+  };
+  return table;
+}
+
+std::vector<fs::path> gallery() {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(FLATMARCH_SOURCE_DIR "/scenes"))
+    if (entry.path().extension() == ".json") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(Gallery, HasEverySurfaceOfThePaperAndTheApp) {
+  std::set<std::string> stems;
+  for (const fs::path& f : gallery()) stems.insert(f.stem().string());
+  for (const auto& [name, surface] : expected())
+    EXPECT_TRUE(stems.count(name)) << name << " is missing";
+}
+
+class GalleryScene : public testing::TestWithParam<fs::path> {};
+
+TEST_P(GalleryScene, HasTheStructureOfItsSurface) {
+  const fs::path file = GetParam();
+  const auto it = expected().find(file.stem().string());
+  ASSERT_NE(it, expected().end()) << file << " has no entry in the table of surfaces";
+  const Surface& want = it->second;
+  const Scene s = load_scene(file);
+  std::vector<double> angles;
+  for (const VertexClass& vc : s.vertex_classes)
+    if (vc.singular) angles.push_back(vc.cone_angle / kPi);
+  std::sort(angles.begin(), angles.end());
+  ASSERT_EQ(angles.size(), want.cone_angles_over_pi.size());
+  for (size_t k = 0; k < angles.size(); ++k)
+    EXPECT_NEAR(angles[k], want.cone_angles_over_pi[k], 1e-9);
+  EXPECT_EQ(s.topology.euler_characteristic, want.euler_characteristic);
+  EXPECT_EQ(s.topology.orientable, want.orientable);
+  EXPECT_EQ(s.topology.genus, want.genus);
+  EXPECT_EQ(s.topology.boundary_components, want.boundary_components);
+  EXPECT_FALSE(s.description.empty());
+  // Each has the paper's test object.
+  EXPECT_TRUE(std::any_of(s.objects.begin(), s.objects.end(),
+                          [](const Object& o) { return o.type == ObjectType::hollow_cube; }));
+}
+
+TEST_P(GalleryScene, CameraShowsAnObjectAndMore) {
+  const Scene s = load_scene(GetParam());
+  const Frame f = OracleBackend().render(s, s.camera, 96, 54, {}, {});
+  std::set<float> codes(f.hit.begin(), f.hit.end());
+  EXPECT_GE(codes.size(), 2u) << "every pixel ends the same way";
+  EXPECT_GE(*codes.rbegin(), 0.0f) << "no object in sight";
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, GalleryScene, testing::ValuesIn(gallery()),
+                         [](const testing::TestParamInfo<fs::path>& p) {
+                           return p.param.stem().string();
+                         });
+
+}  // namespace
+}  // namespace flatmarch
