@@ -2,18 +2,16 @@
 // computed by hand, and the report names the fields that disagree with the derived maps.
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include <sys/wait.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "scene/load.hpp"
 #include "scene/peer_import.hpp"
+#include "tests/process.hpp"
 
 namespace flatmarch {
 namespace {
@@ -388,14 +386,6 @@ TEST(PeerImport, MalformedFilesGiveErrorsWithPointers) {
   expect_error(json::array(), "/", "expected an object");
 }
 
-// Runs the program with its output in files; returns the exit status.
-int run_flatmarch(const std::string& args, const fs::path& out, const fs::path& err) {
-  const std::string command =
-      std::string(FLATMARCH_BINARY) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 std::string read_text(const fs::path& path) {
   std::ifstream in(path);
   std::stringstream s;
@@ -407,12 +397,12 @@ TEST(PeerImportCli, WritesTheSceneAndTheReport) {
   const fs::path dir = fs::path(testing::TempDir()) / "peer_import_cli";
   fs::create_directories(dir);
   const fs::path cube = kPeerDir / "cube.json";
-  ASSERT_EQ(run_flatmarch("import-peer " + cube.string() + " -o " + (dir / "cube.json").string() +
-                              " --report-json " + (dir / "report.json").string(),
-                          dir / "stdout", dir / "stderr"),
-            0);
-  EXPECT_EQ(read_text(dir / "stdout"), "");
-  const std::string err = read_text(dir / "stderr");
+  const auto r =
+      test::run_flatmarch({"import-peer", cube.string(), "-o", (dir / "cube.json").string(),
+                           "--report-json", (dir / "report.json").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  const std::string& err = r.err;
   EXPECT_NE(err.find(cube.string() +
                      ": /edges/0/transform/matrix: disagrees: linear part is the inverse"),
             std::string::npos)
@@ -430,10 +420,9 @@ TEST(PeerImportCli, WritesTheSceneAndTheReport) {
             report["findings"].end());
 
   // Without -o the scene goes to stdout.
-  ASSERT_EQ(run_flatmarch("import-peer " + (kPeerDir / "torus.json").string(), dir / "stdout",
-                          dir / "stderr"),
-            0);
-  EXPECT_EQ(json::parse(read_text(dir / "stdout"))["name"], "torus");
+  const auto torus = test::run_flatmarch({"import-peer", (kPeerDir / "torus.json").string()});
+  ASSERT_EQ(torus.exit_code, 0) << torus.err;
+  EXPECT_EQ(json::parse(torus.out)["name"], "torus");
 }
 
 TEST(PeerImportCli, MalformedInputExitsWith2) {
@@ -443,14 +432,13 @@ TEST(PeerImportCli, MalformedInputExitsWith2) {
   peer["gluing"] = {1, 2, 0, 3};
   const fs::path bad = dir / "bad.json";
   std::ofstream(bad) << peer.dump();
-  EXPECT_EQ(run_flatmarch("import-peer " + bad.string(), dir / "stdout", dir / "stderr"), 2);
-  EXPECT_EQ(read_text(dir / "stderr").rfind("error: " + bad.string() + ": /gluing/0: ", 0), 0u)
-      << read_text(dir / "stderr");
+  auto r = test::run_flatmarch({"import-peer", bad.string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err.rfind("error: " + bad.string() + ": /gluing/0: ", 0), 0u) << r.err;
   std::ofstream(dir / "empty.json") << "";
-  EXPECT_EQ(
-      run_flatmarch("import-peer " + (dir / "empty.json").string(), dir / "stdout", dir / "stderr"),
-      2);
-  EXPECT_NE(read_text(dir / "stderr").find("the file is empty"), std::string::npos);
+  r = test::run_flatmarch({"import-peer", (dir / "empty.json").string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("the file is empty"), std::string::npos);
 }
 
 }  // namespace
