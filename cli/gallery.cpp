@@ -14,34 +14,7 @@
 
 namespace flatmarch::cli {
 
-namespace {
-
 namespace fs = std::filesystem;
-
-std::string html_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 void add_gallery(CLI::App& app) {
   auto* cmd = app.add_subcommand(
@@ -101,11 +74,11 @@ void add_gallery(CLI::App& app) {
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!o->quiet) std::fprintf(stderr, "%s: %.2f s\n", label.c_str(), seconds);
-        cards += "<section><h2>" + html_escape(scene.name) + "</h2><p>" +
-                 html_escape(scene.description) + "</p><p class=\"derived\">" +
-                 html_escape(surface_summary(scene)) + "</p><img src=\"" + stem + ".png\" alt=\"" +
-                 html_escape(scene.name) + "\"><img class=\"plan\" src=\"" + stem +
-                 ".svg\" alt=\"floor plan of " + html_escape(scene.name) + "\"></section>\n";
+        cards += "<section><h2>" + xml_escape(scene.name) + "</h2><p>" +
+                 xml_escape(scene.description) + "</p><p class=\"derived\">" +
+                 xml_escape(surface_summary(scene)) + "</p><img src=\"" + stem + ".png\" alt=\"" +
+                 xml_escape(scene.name) + "\"><img class=\"plan\" src=\"" + stem +
+                 ".svg\" alt=\"floor plan of " + xml_escape(scene.name) + "\"></section>\n";
       } catch (const SceneError& e) {
         ++failures;
         std::fprintf(stderr, "%s\n", e.what());
@@ -118,7 +91,7 @@ void add_gallery(CLI::App& app) {
              "img{max-width:100%}.plan{max-width:60%;display:block;margin-top:.5em}.derived{color:#"
              "555;font-size:90%}</style></head><body>"
              "<h1>flatmarch gallery</h1><p>Rendered with the "
-          << html_escape(backend.name()) << " backend at " << w << "x" << h << ".</p>\n"
+          << xml_escape(backend.name()) << " backend at " << w << "x" << h << ".</p>\n"
           << cards << "</body></html>\n";
     if (!index)
       throw std::runtime_error("cannot write " + (fs::path(o->out) / "index.html").string());

@@ -26,29 +26,6 @@ constexpr const char* kMirrorColour = "#9bb7c9";
 constexpr const char* kWallColour = "#3d3d3d";
 constexpr const char* kObjectColour = "#6a3d9a";
 
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string rgb(Vec3 c) {
   char buf[8];
   const auto byte = [](double v) {
@@ -301,6 +278,29 @@ void draw_ray(Svg& svg, const Scene& scene, const PlanLayout& layout, const Plan
 }
 
 }  // namespace
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
 
 PlanLayout::PlanLayout(const Scene& scene, double width) : width_(width) {
   Vec2 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());

@@ -40,4 +40,7 @@ struct PlanOptions {
 
 std::string floor_plan_svg(const Scene& scene, const PlanOptions& options);
 
+// Text made safe for XML and HTML: & < > " escaped.
+std::string xml_escape(const std::string& text);
+
 }  // namespace flatmarch
