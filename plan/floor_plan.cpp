@@ -170,9 +170,14 @@ void draw_vertices(Svg& svg, const Scene& scene, const PlanLayout& layout) {
         vc.singular ? kConeColours[static_cast<size_t>(singular_index++) % kConeColours.size()]
                     : "#a0a0a0";
     const std::string label = cone_angle_text(vc.cone_angle);
+    std::vector<Vec2> drawn;  // corners of this class that coincide in the plan get one dot
     for (const Corner& k : vc.corners) {
       const Polygon& polygon = scene.polygons[static_cast<size_t>(k.polygon)];
       const Vec2 at = layout.to_pixels(polygon.vertex(k.vertex));
+      if (std::any_of(drawn.begin(), drawn.end(),
+                      [&](Vec2 p) { return glm::length(p - at) < 1.0; }))
+        continue;
+      drawn.push_back(at);
       svg << "<circle class=\"" << (vc.singular ? "cone-point" : "vertex") << "\" data-class=\""
           << c << "\" cx=\"" << at.x << "\" cy=\"" << at.y << "\" r=\"" << (vc.singular ? 5.0 : 2.5)
           << "\" fill=\"" << colour << "\"/>\n";
@@ -324,9 +329,12 @@ std::string floor_plan_svg(const Scene& scene, const PlanOptions& options) {
   svg << "<text class=\"title\" x=\"10\" y=\"18\" font-size=\"15\" font-weight=\"bold\">"
       << xml_escape(scene.name) << "</text>\n";
   svg << "<text class=\"summary\" x=\"10\" y=\"34\" font-size=\"11\" fill=\"#555\">"
-      << xml_escape(surface_summary(scene))
-      << " · edges of one colour are glued, arrows matching · pale blue: mirror · dark: "
-         "wall</text>\n";
+      << xml_escape(surface_summary(scene)) << "</text>\n";
+  svg << "<text class=\"legend\" x=\"10\" y=\"49\" font-size=\"10\" fill=\"#777\">"
+      << "edges of one colour are glued, their arrows matching · pale blue: mirror · dark grey: "
+         "wall"
+      << " · dots: cone points with their angle" << (options.ray ? " · pink: a light ray" : "")
+      << "</text>\n";
   draw_polygons(svg, scene, layout);
   draw_objects(svg, scene, layout);
   draw_edges(svg, scene, layout);

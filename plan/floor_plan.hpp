@@ -15,7 +15,7 @@ namespace flatmarch {
 // margin of 6% of its larger side, scaled to `width` pixels, below a title band.
 class PlanLayout {
  public:
-  static constexpr double kTitleHeight = 40.0;
+  static constexpr double kTitleHeight = 56.0;
   static constexpr double kMarginFraction = 0.06;
 
   PlanLayout(const Scene& scene, double width);

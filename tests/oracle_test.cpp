@@ -159,6 +159,21 @@ TEST(OracleTransport, RayThroughAVertexEndsThere) {
   EXPECT_NEAR(near_miss.trace.events[0].at.x, 4 - 1e-9, 1e-12);
 }
 
+TEST(OracleTransport, VertexAtTheExitPointAfterGluingsIsAVertex) {
+  // On the cube net of side 2 (scenes/cube.json) a ray along (-47, 17) from (3.4, 0.6) in the
+  // right face is rational all the way: it enters the bottom face at (60/47, -2) heading
+  // (17, 47) and so meets that face's corner (2, 0) exactly. In floating point it arrives a
+  // rounding error below the corner; that is still the vertex, not a crossing of the edge.
+  const Scene s = load_scene(FLATMARCH_SOURCE_DIR "/scenes/cube.json");
+  const OracleResult r = trace(s, {3.4, 0.6, 1.2}, {-0.94, 0.34, 0}, 1);
+  ASSERT_FALSE(r.trace.events.empty());
+  const Event& last = r.trace.events.back();
+  EXPECT_EQ(last.kind, EventKind::vertex);
+  EXPECT_EQ(last.polygon, 5);
+  expect_near(last.at, {2, 0, 1.2}, 1e-12);
+  expect_near(r.path.back().from, {60.0 / 47.0, -2, 1.2}, 1e-12);
+}
+
 TEST(OracleTransport, EscapeFloorAndPeriod) {
   // Rising at slope 4/3 from z = 1, the ray leaves the band (height 2) at t = 1 / 0.8.
   const Scene torus = load(test::torus_json());

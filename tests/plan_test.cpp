@@ -63,10 +63,10 @@ std::vector<Element> elements(const std::string& svg, const std::string& cls) {
 }
 
 // The torus [0,4]^2 in an 800 pixel wide plan: a margin of 0.06 * 4 = 0.24, so 4.48 units span
-// 800 pixels (178.571 a unit) below a 40 pixel title: (x, y) -> (178.571 (x + 0.24),
-// 40 + 178.571 (4.24 - y)).
+// 800 pixels (178.571 a unit) below a 56 pixel title: (x, y) -> (178.571 (x + 0.24),
+// 56 + 178.571 (4.24 - y)).
 Vec2 torus_pixels(Vec2 p) {
-  return {800.0 / 4.48 * (p.x + 0.24), 40.0 + 800.0 / 4.48 * (4.24 - p.y)};
+  return {800.0 / 4.48 * (p.x + 0.24), 56.0 + 800.0 / 4.48 * (4.24 - p.y)};
 }
 
 TEST(FloorPlan, TorusLayoutObjectsAndRay) {
@@ -82,7 +82,7 @@ TEST(FloorPlan, TorusLayoutObjectsAndRay) {
   const auto objects = elements(svg, "object");
   ASSERT_EQ(objects.size(), 1u);
   EXPECT_NEAR(objects[0].number("cx"), 400.0, 0.01);
-  EXPECT_NEAR(objects[0].number("cy"), 440.0, 0.01);
+  EXPECT_NEAR(objects[0].number("cy"), 456.0, 0.01);
   EXPECT_NEAR(objects[0].number("r"), 0.5 * 800.0 / 4.48, 0.01);
 
   // The ray from (1, 1) along (3, 1) leaves through the right edge at (4, 2), comes back in at

@@ -151,7 +151,9 @@ class Tracer {
     const Polygon& polygon = scene_.polygons[static_cast<size_t>(p_)];
     const Vec2 o(o_), dh(d_);
     const Exit exit = find_exit(polygon, o, dh);
-    const VertexMeet vertex = find_vertex(polygon, o, dh, exit.t);
+    VertexMeet vertex = find_vertex(polygon, o, dh, exit.t);
+    // A vertex met at the exit point may lie a rounding error beyond it; it still comes first.
+    if (vertex.vertex >= 0) vertex.t = std::min(vertex.t, exit.t);
 
     double band = kInf;  // leaving the band: escape, floor, or a period wrap
     const double top = scene_.period ? *scene_.period : scene_.height;
