@@ -53,34 +53,6 @@ std::optional<Method> parse_method(const std::string& name) {
 const char* to_string(EventKind k) {
   return name_of(kEventKinds, k);
 }
-std::optional<EventKind> parse_event_kind(const std::string& name) {
-  return value_of(kEventKinds, name);
-}
-
-bool is_final(EventKind k) {
-  return k != EventKind::gluing && k != EventKind::mirror && k != EventKind::enter;
-}
-
-int hit_code(EventKind final_kind, int object) {
-  switch (final_kind) {
-    case EventKind::object:
-      return object;
-    case EventKind::wall:
-      return kHitWall;
-    case EventKind::floor:
-      return kHitFloor;
-    case EventKind::escape:
-      return kHitEscape;
-    case EventKind::vertex:
-      return kHitVertex;
-    case EventKind::max_steps:
-      return kHitMaxSteps;
-    case EventKind::max_distance:
-      return kHitMaxDistance;
-    default:
-      return kHitMiss;
-  }
-}
 
 Frame::Frame(int w, int h)
     : width(w),

@@ -52,9 +52,6 @@ enum class EventKind {
   miss
 };
 const char* to_string(EventKind k);
-std::optional<EventKind> parse_event_kind(const std::string& name);
-bool is_final(EventKind k);
-int hit_code(EventKind final_kind, int object);  // the `hit` AOV value of a final event
 
 struct Event {
   EventKind kind = EventKind::gluing;
