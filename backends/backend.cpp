@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "backends/oracle/oracle.hpp"
+#include "backends/scalar/scalar.hpp"
 
 namespace flatmarch {
 
@@ -67,6 +68,7 @@ const std::vector<std::unique_ptr<Backend>>& backends() {
   static const std::vector<std::unique_ptr<Backend>> all = [] {
     std::vector<std::unique_ptr<Backend>> v;
     v.push_back(std::make_unique<OracleBackend>());
+    v.push_back(std::make_unique<ScalarBackend>());
     return v;
   }();
   return all;

@@ -8,26 +8,14 @@
 #include <string>
 #include <vector>
 
-#include "kernels/hit.hpp"
+#include "kernels/constants.hpp"
+#include "kernels/march_params.hpp"
 #include "scene/scene.hpp"
 
 namespace flatmarch {
 
-enum class Method { sphere, relaxed, analytic, oracle };
-enum class Precision { f32, f64 };
-
 const char* to_string(Method m);
 std::optional<Method> parse_method(const std::string& name);
-
-struct MarchParams {
-  Method method = Method::sphere;
-  double eps = 1e-4;
-  double offset = 2e-4;
-  int max_steps = 1024;
-  double max_distance = 100.0;
-  double omega = 1.6;
-  Precision precision = Precision::f32;
-};
 
 // One ray, in the coordinates of `polygon` (ignored when `from` lies outside every wall band).
 struct Ray {
@@ -52,6 +40,12 @@ enum class EventKind {
   miss
 };
 const char* to_string(EventKind k);
+// The kernel reports events by these numbers (kEvent*, kernels/constants.glsl).
+static_assert(static_cast<int>(EventKind::gluing) == kEventGluing &&
+              static_cast<int>(EventKind::enter) == kEventEnter &&
+              static_cast<int>(EventKind::object) == kEventObject &&
+              static_cast<int>(EventKind::vertex) == kEventVertex &&
+              static_cast<int>(EventKind::miss) == kEventMiss);
 
 struct Event {
   EventKind kind = EventKind::gluing;

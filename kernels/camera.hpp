@@ -27,12 +27,18 @@ CameraBasis<T> camera_basis(T yaw_deg, T pitch_deg, T fov_deg, int width, int he
   return c;
 }
 
-// Unit direction of pixel (i, j), row j = 0 at the top.
+// Unit direction through the image point (x, y), in pixels from the top left corner.
+template <typename T>
+glm::vec<3, T> camera_ray_at(const CameraBasis<T>& c, T x, T y, int width, int height) {
+  const T u = (T(2) * x / T(width) - T(1)) * c.aspect * c.tan_half_fov;
+  const T v = (T(1) - T(2) * y / T(height)) * c.tan_half_fov;
+  return glm::normalize(c.forward + u * c.right + v * c.up);
+}
+
+// Unit direction of pixel (i, j), row j = 0 at the top: through its centre.
 template <typename T>
 glm::vec<3, T> camera_ray(const CameraBasis<T>& c, int i, int j, int width, int height) {
-  const T u = (T(2) * (T(i) + T(0.5)) / T(width) - T(1)) * c.aspect * c.tan_half_fov;
-  const T v = (T(1) - T(2) * (T(j) + T(0.5)) / T(height)) * c.tan_half_fov;
-  return glm::normalize(c.forward + u * c.right + v * c.up);
+  return camera_ray_at(c, T(i) + T(0.5), T(j) + T(0.5), width, height);
 }
 
 }  // namespace flatmarch

@@ -9,7 +9,7 @@
 
 #include "backends/oracle/intersect.hpp"
 #include "kernels/camera.hpp"
-#include "kernels/shade.hpp"
+#include "kernels/compile.hpp"
 
 namespace flatmarch {
 
@@ -297,12 +297,24 @@ OracleResult oracle_trace(const Scene& scene, const Ray& ray, const MarchParams&
 }
 
 Vec3 oracle_color(const Scene& scene, const RayEnd& end) {
-  const Vec3* color = nullptr;
-  if (end.hit >= 0 && end.hit < static_cast<int>(scene.objects.size()) &&
-      scene.objects[static_cast<size_t>(end.hit)].color)
-    color = &*scene.objects[static_cast<size_t>(end.hit)].color;
-  return shade<double>(end.hit, end.crossings, end.normal, end.at, color, scene.look.wall_tint,
-                       scene.look.fog, scene.look.background);
+  // The kernel's shading, in float64 and specialised on nothing: only its look is needed.
+  using Shader = kernel::Kernel<double, 0u>;
+  Shader shader;
+  kernel::set_look<double>(scene.look, shader.params);
+  Shader::Ray r{};
+  r.hit = end.hit;
+  r.crossings = end.crossings;
+  r.o = end.at;
+  r.normal = end.normal;
+  if (end.hit >= 0) {
+    const Object* object = end.hit < static_cast<int>(scene.objects.size())
+                               ? &scene.objects[static_cast<size_t>(end.hit)]
+                               : nullptr;
+    const glm::dvec4 color =
+        object && object->color ? glm::dvec4(*object->color, 1.0) : glm::dvec4(0.0);
+    r.surface = shader.solid_surface(color, end.normal);
+  }
+  return shader.shade(r);
 }
 
 std::string OracleBackend::description() const {

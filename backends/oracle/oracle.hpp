@@ -11,9 +11,6 @@
 
 namespace flatmarch {
 
-// A ray passing within this distance of a vertex meets it (DESIGN.md section 3).
-inline constexpr double kVertexTolerance = 1e-12;
-
 // How a ray ended, with what shading needs.
 struct RayEnd {
   int hit = kHitMiss;

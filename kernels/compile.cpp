@@ -1,0 +1,165 @@
+#include "kernels/compile.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace flatmarch::kernel {
+
+namespace {
+
+bool is_isometry(const Affine2& map) {
+  const Mat2 gram = glm::transpose(map.linear) * map.linear;
+  constexpr double kTolerance = 1e-12;
+  return std::abs(gram[0][0] - 1.0) <= kTolerance && std::abs(gram[1][1] - 1.0) <= kTolerance &&
+         std::abs(gram[0][1]) <= kTolerance;
+}
+
+int kernel_method(Method m) {
+  switch (m) {
+    case Method::sphere:
+      return kMethodSphere;
+    case Method::relaxed:
+      return kMethodRelaxed;
+    case Method::analytic:
+      return kMethodAnalytic;
+    case Method::oracle:
+      break;
+  }
+  return -1;
+}
+
+template <typename real>
+typename Tables<real>::ObjectRecord object_record(const Object& o, int hit_index) {
+  using vec4 = typename Types<real>::vec4;
+  typename Tables<real>::ObjectRecord r{};
+  double bound = 0.0;
+  switch (o.type) {
+    case ObjectType::sphere:
+      r.info.x = kSolidSphere;
+      r.shape = vec4(real(o.radius), 0, 0, 0);
+      bound = o.radius;
+      break;
+    case ObjectType::box:
+      r.info.x = kSolidBox;
+      r.shape = vec4(glm::vec<3, real>(o.half), 0);
+      bound = glm::length(o.half);
+      break;
+    case ObjectType::hollow_cube:
+      r.info.x = kSolidHollowCube;
+      r.shape = vec4(real(o.size), real(o.size), real(o.size), real(o.hole));
+      bound = std::sqrt(3.0) * o.size;
+      break;
+    case ObjectType::cylinder: {
+      const double half_height = 0.5 * (o.z1 - o.z0);
+      r.info.x = kSolidCylinder;
+      r.shape = vec4(real(o.radius), real(half_height), 0, 0);
+      bound = std::hypot(o.radius, half_height);
+      break;
+    }
+  }
+  r.center = vec4(glm::vec<3, real>(o.center), real(bound));
+  if (o.color) r.color = vec4(glm::vec<3, real>(*o.color), 1);
+  r.info.y = hit_index;
+  return r;
+}
+
+}  // namespace
+
+uint scene_features(const Scene& scene) {
+  uint f = 0;
+  if (!scene.objects.empty() || !scene.markers.empty()) f |= kFeatureObjects;
+  for (const Polygon& polygon : scene.polygons)
+    for (const Edge& edge : polygon.edges) {
+      if (edge.kind == EdgeKind::mirror) f |= kFeatureMirrors;
+      if (edge.kind == EdgeKind::wall) f |= kFeatureWalls;
+      if (edge.kind == EdgeKind::glued && !is_isometry(edge.map)) f |= kFeatureScaled;
+    }
+  if (scene.period) f |= kFeaturePeriod;
+  if (scene.floor) f |= kFeatureFloor;
+  return f;
+}
+
+template <typename real>
+SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
+  using vec4 = typename Types<real>::vec4;
+  SceneTables<real> t;
+  t.features = scene_features(scene);
+  const double top = scene.period ? *scene.period : scene.height;
+
+  for (size_t p = 0; p < scene.polygons.size(); ++p) {
+    const Polygon& polygon = scene.polygons[p];
+    const int first_edge = static_cast<int>(t.edges.size());
+    const int first_object = static_cast<int>(t.objects.size());
+    for (int i = 0; i < polygon.size(); ++i) {
+      const Edge& edge = polygon.edges[static_cast<size_t>(i)];
+      const Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1);
+      typename Tables<real>::EdgeRecord r{};
+      r.segment = vec4(real(a.x), real(a.y), real(b.x), real(b.y));
+      r.line = vec4(real(edge.normal.x), real(edge.normal.y), real(glm::dot(edge.normal, a)),
+                    real(1.0 / glm::dot(b - a, b - a)));
+      r.link.x = edge.kind == EdgeKind::glued   ? kEdgeGlued
+                 : edge.kind == EdgeKind::mirror ? kEdgeMirror
+                                                 : kEdgeWall;
+      if (edge.kind == EdgeKind::glued) {
+        const Mat2& m = edge.map.linear;
+        r.map_linear = vec4(real(m[0][0]), real(m[0][1]), real(m[1][0]), real(m[1][1]));
+        r.map_shift = vec4(real(edge.map.translation.x), real(edge.map.translation.y), 0, 0);
+        r.link.y = edge.to.polygon;
+        r.link.z = edge.to.edge;
+      }
+      t.edges.push_back(r);
+    }
+    // The room's solids: its objects, then a cylinder at each corner that carries a marker.
+    for (size_t k = 0; k < scene.objects.size(); ++k)
+      if (scene.objects[k].polygon == static_cast<int>(p))
+        t.objects.push_back(object_record<real>(scene.objects[k], static_cast<int>(k)));
+    for (int v = 0; v < polygon.size(); ++v) {
+      const int m = scene.marker_at(static_cast<int>(p), v);
+      if (m < 0) continue;
+      Object cylinder;
+      cylinder.type = ObjectType::cylinder;
+      cylinder.center = Vec3(polygon.vertex(v), 0.5 * top);
+      cylinder.radius = scene.markers[static_cast<size_t>(m)].radius;
+      cylinder.z0 = 0.0;
+      cylinder.z1 = top;
+      t.objects.push_back(
+          object_record<real>(cylinder, static_cast<int>(scene.objects.size()) + m));
+    }
+    t.polygons.push_back(ivec4(first_edge, polygon.size(), first_object,
+                               static_cast<int>(t.objects.size()) - first_object));
+  }
+
+  typename Tables<real>::KernelParams& k = t.params;
+  k.method = kernel_method(march.method);
+  k.max_steps = march.max_steps;
+  k.polygon_count = static_cast<int>(scene.polygons.size());
+  k.eps = real(march.eps);
+  k.offset = real(march.offset);
+  k.max_distance = real(march.max_distance);
+  k.omega = real(march.omega);
+  k.height = real(scene.height);
+  k.top = real(top);
+  // Rounding decides which of two edges a ray leaving near their vertex takes: within a few
+  // ulps of the scene's scale (never less than the oracle's tolerance) it meets the vertex.
+  constexpr double kUlp = std::numeric_limits<real>::epsilon();
+  k.vertex_tolerance = real(std::max(kVertexTolerance, 8.0 * kUlp * scene.scale));
+  // The step that balances rounding against truncation in central differences.
+  k.normal_step = real(std::cbrt(kUlp) * scene.scale);
+  set_look<real>(scene.look, k);
+  return t;
+}
+
+template <typename real>
+void set_look(const Look& look, typename Tables<real>::KernelParams& params) {
+  using vec4 = typename Types<real>::vec4;
+  params.wall_tint = real(look.wall_tint);
+  params.fog = vec4(glm::vec<3, real>(look.fog), 0);
+  params.background = vec4(glm::vec<3, real>(look.background), 0);
+}
+
+template SceneTables<float> compile_scene(const Scene&, const MarchParams&);
+template SceneTables<double> compile_scene(const Scene&, const MarchParams&);
+template void set_look<float>(const Look&, Tables<float>::KernelParams&);
+template void set_look<double>(const Look&, Tables<double>::KernelParams&);
+
+}  // namespace flatmarch::kernel

@@ -1,0 +1,38 @@
+// The scene compiler: a validated scene becomes the flat tables every backend consumes
+// unchanged (kernels/tables.glsl), holding only what the scene uses.
+#pragma once
+
+#include <vector>
+
+#include "kernels/kernel.hpp"
+#include "kernels/march_params.hpp"
+#include "scene/scene.hpp"
+
+namespace flatmarch::kernel {
+
+template <typename real>
+struct SceneTables {
+  uint features = 0;  // kFeature* the scene uses
+  std::vector<ivec4> polygons;
+  std::vector<typename Tables<real>::EdgeRecord> edges;
+  std::vector<typename Tables<real>::ObjectRecord> objects;
+  typename Tables<real>::KernelParams params{};
+};
+
+// The feature set of a scene (kFeature*).
+uint scene_features(const Scene& scene);
+
+// `march.method` must be one the kernel runs (sphere, relaxed, analytic).
+template <typename real>
+SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march);
+
+// The appearance part of the kernel's parameters.
+template <typename real>
+void set_look(const Look& look, typename Tables<real>::KernelParams& params);
+
+extern template SceneTables<float> compile_scene(const Scene&, const MarchParams&);
+extern template SceneTables<double> compile_scene(const Scene&, const MarchParams&);
+extern template void set_look<float>(const Look&, Tables<float>::KernelParams&);
+extern template void set_look<double>(const Look&, Tables<double>::KernelParams&);
+
+}  // namespace flatmarch::kernel

@@ -1,0 +1,480 @@
+// The ray-marching kernel of DESIGN.md section 3, written once for every backend in the GLSL
+// subset of kernels/glsl.hpp. It reads the tables of kernels/tables.glsl (`polygons`, `edges`,
+// `objects`, `params`) and calls `record_event`, both provided by whoever includes it; FEATURES
+// is the feature set the kernel is specialised on (kFeature* in kernels/constants.glsl).
+//
+// A ray lives in one room at a time: its point `o` and unit direction `d` are in the
+// coordinates of `polygon`. Per iteration only that polygon's edges and solids are evaluated.
+//   sphere    sphere tracing against min(walls, solids) (Lander & Taha): a wall nearer than eps
+//             is crossed, and the point placed `offset` inside the destination room
+//   relaxed   the same, over-relaxed by omega (Keinert et al. 2014); a step whose unbounding
+//             sphere does not overlap the last one is taken back and redone plainly
+//   analytic  the exit edge and point computed exactly; sphere tracing only for solids, and
+//             only from where the room segment enters a solid's bounding sphere
+// The band [0, top] is left analytically by every method (z is linear along a ray).
+//
+// Defined failures: a ray within eps of two edges at once (sphere, relaxed) or exiting within
+// vertex_tolerance of a vertex (analytic) ends with `vertex`; with offset <= eps a placed point
+// is still within eps of the edge it came through and the ray crosses back and forth until
+// max_steps; a ray grazing a wall creeps along it in steps of its distance to the wall until it
+// gets there or reaches max_steps. The loop runs at most max_steps times.
+
+bool has(uint feature) {
+  return (FEATURES & feature) != 0u;
+}
+
+// What a ray is doing, and once `done`, how it ended.
+struct Ray {
+  int polygon;
+  vec3 o;  // point, in the coordinates of `polygon`
+  vec3 d;  // unit direction
+  real t;  // path length so far
+  int steps;
+  int crossings;  // gluings crossed and mirror bounces
+  int hit;        // the hit AOV, once done
+  bool done;
+  vec3 normal;   // of the solid hit
+  vec3 surface;  // the colour of the solid hit
+};
+
+void advance(INOUT(Ray) r, real s) {
+  r.o = r.o + s * r.d;
+  r.t = r.t + s;
+}
+
+// Ends the ray `s` further on.
+void finish(INOUT(Ray) r, int hit, int event, int edge, real s) {
+  advance(r, s);
+  r.hit = hit;
+  r.done = true;
+  record_event(event, r.polygon, edge, -1, -1, hit >= 0 ? hit : -1, r.t, r.o);
+}
+
+// ---- Walls -----------------------------------------------------------------------------------
+
+// Whether the horizontal ray from p in +x crosses the edge from a to a + ab (crossing number).
+bool crosses(vec2 a, vec2 ab, vec2 p) {
+  vec2 ap = p - a;
+  bool below = p.y >= a.y;
+  bool above = p.y < a.y + ab.y;
+  bool left = ab.x * ap.y > ab.y * ap.x;
+  return (below && above && left) || (!below && !above && !left);
+}
+
+bool inside_polygon(int polygon, vec2 p) {
+  ivec4 poly = polygons[polygon];
+  bool inside = false;
+  for (int k = poly.x; k < poly.x + poly.y; ++k) {
+    vec4 s = edges[k].segment;
+    if (crosses(vec2(s.x, s.y), vec2(s.z - s.x, s.w - s.y), p)) inside = !inside;
+  }
+  return inside;
+}
+
+// Distance from a point to the walls of its room: to the nearest edge (negative outside the
+// polygon), which edge that is, and the distance to the next nearest one.
+struct WallDistance {
+  real d;
+  int edge;
+  real second;
+};
+
+WallDistance wall_distance(int polygon, vec2 p) {
+  ivec4 poly = polygons[polygon];
+  real best = real(kFar);
+  real second = real(kFar);
+  int edge = -1;
+  bool inside = false;
+  for (int k = 0; k < poly.y; ++k) {
+    vec4 s = edges[poly.x + k].segment;
+    vec2 a = vec2(s.x, s.y);
+    vec2 ab = vec2(s.z, s.w) - a;
+    real h = clamp(dot(p - a, ab) * edges[poly.x + k].line.w, real(0), real(1));
+    vec2 q = p - a - h * ab;
+    real d2 = dot(q, q);
+    if (d2 < best) {
+      second = best;
+      best = d2;
+      edge = k;
+    } else if (d2 < second) {
+      second = d2;
+    }
+    if (crosses(a, ab, p)) inside = !inside;
+  }
+  WallDistance w;
+  w.d = inside ? sqrt(best) : -sqrt(best);
+  w.edge = edge;
+  w.second = sqrt(second);
+  return w;
+}
+
+// The edge through which a ray from o along dh leaves its polygon, at distance s along the ray
+// (d's horizontal part has the length that makes s a 3D distance), and whether it leaves at a
+// vertex.
+struct Exit {
+  real s;
+  int edge;
+  bool corner;
+};
+
+Exit exit_edge(int polygon, vec2 o, vec2 dh) {
+  ivec4 poly = polygons[polygon];
+  Exit x;
+  x.s = real(kFar);
+  x.edge = -1;
+  x.corner = false;
+  for (int k = 0; k < poly.y; ++k) {
+    vec4 line = edges[poly.x + k].line;
+    vec2 n = vec2(line.x, line.y);
+    real dn = dot(dh, n);
+    if (dn <= real(0)) continue;  // the ray cannot leave through this edge
+    real s = (line.z - dot(o, n)) / dn;
+    if (s < -params.vertex_tolerance || s >= x.s) continue;
+    vec4 seg = edges[poly.x + k].segment;
+    vec2 a = vec2(seg.x, seg.y);
+    real u = dot(o + s * dh - a, vec2(seg.z, seg.w) - a) * line.w;  // 0 at a, 1 at b
+    real tolerance = params.vertex_tolerance * sqrt(line.w);        // in units of u
+    if (u < -tolerance || u > real(1) + tolerance) continue;
+    x.s = max(s, real(0));
+    x.edge = k;
+    x.corner = u <= tolerance || u >= real(1) - tolerance;
+  }
+  return x;
+}
+
+// Distance along the ray to where it leaves the band [0, top].
+real band_exit(vec3 o, vec3 d) {
+  if (d.z > real(0)) return (params.top - o.z) / d.z;
+  if (d.z < real(0)) return -o.z / d.z;
+  return real(kFar);
+}
+
+// Moves p along the normal of an edge's line so that it lies `inside` within it (negative:
+// beyond it).
+vec2 place(vec2 p, vec4 line, real inside) {
+  vec2 n = vec2(line.x, line.y);
+  return p - (dot(p, n) - line.z + inside) * n;
+}
+
+// A ray at edge k of its polygon goes through it into the glued room, or is reflected by a
+// mirror. Either way its point is then placed `push` inside the edge it is now behind (the
+// paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
+// one it was.
+void cross_edge(INOUT(Ray) r, int k, real push) {
+  int e = polygons[r.polygon].x + k;
+  vec4 line = edges[e].line;
+  vec2 dh = vec2(r.d);
+  if (has(kFeatureMirrors) && edges[e].link.x == kEdgeMirror) {
+    record_event(kEventMirror, r.polygon, k, -1, -1, -1, r.t, r.o);
+    vec2 n = vec2(line.x, line.y);
+    r.o = vec3(place(vec2(r.o), line, push), r.o.z);
+    r.d = vec3(dh - real(2) * dot(dh, n) * n, r.d.z);
+  } else {
+    ivec4 link = edges[e].link;
+    record_event(kEventGluing, r.polygon, k, link.y, link.z, -1, r.t, r.o);
+    vec4 m = edges[e].map_linear;
+    vec4 shift = edges[e].map_shift;
+    vec2 p = vec2(r.o);
+    p = vec2(m.x * p.x + m.z * p.y, m.y * p.x + m.w * p.y) + vec2(shift.x, shift.y);
+    dh = vec2(m.x * dh.x + m.z * dh.y, m.y * dh.x + m.w * dh.y);
+    r.o = vec3(place(p, edges[polygons[link.y].x + link.z].line, push), r.o.z);
+    r.d = vec3(dh, r.d.z);
+    // Under a map that is not an isometry the direction is renormalised (DESIGN.md section 1).
+    if (has(kFeatureScaled)) r.d = normalize(r.d);
+    r.polygon = link.y;
+  }
+  r.crossings += 1;
+}
+
+bool is_wall(int polygon, int k) {
+  return has(kFeatureWalls) && edges[polygons[polygon].x + k].link.x == kEdgeWall;
+}
+
+// The ray reaches the top or bottom of the band, `s` further on.
+void leave_band(INOUT(Ray) r, real s) {
+  if (has(kFeaturePeriod)) {  // z is taken modulo the period
+    advance(r, s);
+    r.o.z = r.d.z > real(0) ? real(0) : params.top;
+  } else if (has(kFeatureFloor) && r.d.z < real(0)) {
+    finish(r, kHitFloor, kEventFloor, -1, s);
+    r.normal = vec3(real(0), real(0), real(1));
+  } else {
+    finish(r, kHitEscape, kEventEscape, -1, s);
+  }
+}
+
+// ---- Solids ----------------------------------------------------------------------------------
+
+// Signed distance from p to solid k of the object table (the paper's SDFs).
+real solid_distance(int k, vec3 p) {
+  vec4 c = objects[k].center;
+  vec4 shape = objects[k].shape;
+  int solid = objects[k].info.x;
+  vec3 q = p - vec3(c);
+  if (solid == kSolidSphere) return length(q) - shape.x;
+  if (solid == kSolidCylinder) {
+    vec2 w = vec2(length(vec2(q)) - shape.x, abs(q.z) - shape.y);
+    return min(max(w.x, w.y), real(0)) + length(max(w, vec2(real(0))));
+  }
+  vec3 w = abs(q) - vec3(shape);
+  real box = length(max(w, vec3(real(0)))) + min(max(w.x, max(w.y, w.z)), real(0));
+  if (solid == kSolidBox) return box;
+  return max(box, shape.w - length(q));  // hollow cube: the cube minus the sphere
+}
+
+struct SolidDistance {
+  real d;
+  int object;  // index in the object table
+};
+
+SolidDistance nearest_solid(int polygon, vec3 p) {
+  SolidDistance best;
+  best.d = real(kFar);
+  best.object = -1;
+  if (!has(kFeatureObjects)) return best;
+  ivec4 poly = polygons[polygon];
+  for (int k = poly.z; k < poly.z + poly.w; ++k) {
+    real d = solid_distance(k, p);
+    if (d < best.d) {
+      best.d = d;
+      best.object = k;
+    }
+  }
+  return best;
+}
+
+// Where a ray first comes within eps of a solid's bounding sphere in its room, or kFar.
+real solid_entry(int polygon, vec3 o, vec3 d) {
+  ivec4 poly = polygons[polygon];
+  real first = real(kFar);
+  for (int k = poly.z; k < poly.z + poly.w; ++k) {
+    vec4 c = objects[k].center;
+    vec3 oc = o - vec3(c);
+    real radius = c.w + params.eps;
+    real b = dot(oc, d);
+    real cc = dot(oc, oc) - radius * radius;
+    if (cc <= real(0)) return real(0);  // already inside one
+    real disc = b * b - cc;
+    if (b < real(0) && disc >= real(0)) first = min(first, -b - sqrt(disc));
+  }
+  return first;
+}
+
+// The gradient of the solid's distance by central differences on a tetrahedron.
+vec3 solid_normal(int k, vec3 p) {
+  real h = params.normal_step;
+  vec3 a = vec3(real(1), real(-1), real(-1));
+  vec3 b = vec3(real(-1), real(-1), real(1));
+  vec3 c = vec3(real(-1), real(1), real(-1));
+  vec3 e = vec3(real(1), real(1), real(1));
+  return normalize(a * solid_distance(k, p + h * a) + b * solid_distance(k, p + h * b) +
+                   c * solid_distance(k, p + h * c) + e * solid_distance(k, p + h * e));
+}
+
+// A solid's own colour when it has one (w > 0), else its normal's (DESIGN.md section 1).
+vec3 solid_surface(vec4 color, vec3 normal) {
+  return color.w > real(0) ? vec3(color) : real(0.5) + real(0.5) * normal;
+}
+
+void hit_solid(INOUT(Ray) r, int k) {
+  r.normal = solid_normal(k, r.o);
+  r.surface = solid_surface(objects[k].color, r.normal);
+  finish(r, objects[k].info.y, kEventObject, -1, real(0));
+}
+
+// ---- Methods ---------------------------------------------------------------------------------
+
+// State of over-relaxed sphere tracing within one room.
+struct Relaxation {
+  real omega;        // 1 after a failed over-relaxed step
+  real last_radius;  // unbounding radius at the previous point
+  real last_step;    // how far the previous step went
+};
+
+void relax(INOUT(Relaxation) x) {
+  x.omega = params.method == kMethodRelaxed ? params.omega : real(1);
+  x.last_radius = real(0);
+  x.last_step = real(0);
+}
+
+// One iteration of sphere or over-relaxed sphere tracing.
+void sphere_step(INOUT(Ray) r, INOUT(Relaxation) x) {
+  WallDistance wall = wall_distance(r.polygon, vec2(r.o));
+  SolidDistance solid = nearest_solid(r.polygon, r.o);
+  real radius = min(wall.d, solid.d);
+  if (x.omega > real(1) && radius + x.last_radius < x.last_step) {
+    // The unbounding spheres do not overlap: something may lie between. Go back and take the
+    // plain step from the previous point (Keinert et al.'s fallback).
+    advance(r, x.last_radius - x.last_step);
+    x.last_step = x.last_radius;
+    x.omega = real(1);
+    return;
+  }
+  real wall_d = abs(wall.d);
+  if (solid.d < params.eps && solid.d <= wall_d) {
+    hit_solid(r, solid.object);
+    return;
+  }
+  if (wall_d < params.eps) {
+    if (wall.second < params.eps) {
+      finish(r, kHitVertex, kEventVertex, -1, real(0));  // in a corner: no single edge to cross
+    } else if (is_wall(r.polygon, wall.edge)) {
+      finish(r, kHitWall, kEventWall, wall.edge, real(0));
+    } else {
+      cross_edge(r, wall.edge, params.offset);
+      relax(x);
+    }
+    return;
+  }
+  real safe = abs(radius);
+  real band = band_exit(r.o, r.d);
+  real remaining = params.max_distance - r.t;
+  if (remaining <= min(safe, band)) {
+    finish(r, kHitMaxDistance, kEventMaxDistance, -1, remaining);
+  } else if (band <= safe) {
+    leave_band(r, band);
+    relax(x);
+  } else {
+    x.last_radius = safe;
+    x.last_step = min(x.omega * safe, min(band, remaining));
+    advance(r, x.last_step);
+  }
+}
+
+// The current room segment of the analytic method, as distances from the ray's point.
+struct Segment {
+  bool known;
+  Exit exit;
+  real solids;  // where sphere tracing of the solids starts
+};
+
+void move_in_segment(INOUT(Ray) r, INOUT(Segment) seg, real s) {
+  advance(r, s);
+  seg.exit.s -= s;
+  seg.solids = max(seg.solids - s, real(0));
+}
+
+// One iteration of the analytic method: a step of sphere tracing towards a solid, or the whole
+// rest of the room segment.
+void analytic_step(INOUT(Ray) r, INOUT(Segment) seg) {
+  if (!seg.known) {
+    seg.exit = exit_edge(r.polygon, vec2(r.o), vec2(r.d));
+    seg.solids = has(kFeatureObjects) ? solid_entry(r.polygon, r.o, r.d) : real(kFar);
+    seg.known = true;
+  }
+  real remaining = params.max_distance - r.t;
+  if (has(kFeatureObjects) &&
+      seg.solids < min(min(seg.exit.s, band_exit(r.o, r.d)), remaining)) {
+    move_in_segment(r, seg, seg.solids);  // nothing to meet before the first bounding sphere
+    SolidDistance solid = nearest_solid(r.polygon, r.o);
+    if (solid.d < params.eps) {
+      hit_solid(r, solid.object);
+      return;
+    }
+    remaining = params.max_distance - r.t;
+    if (solid.d < min(min(seg.exit.s, band_exit(r.o, r.d)), remaining)) {
+      move_in_segment(r, seg, solid.d);
+      return;
+    }
+  }
+  real band = band_exit(r.o, r.d);
+  if (remaining < min(seg.exit.s, band)) {
+    finish(r, kHitMaxDistance, kEventMaxDistance, -1, remaining);
+  } else if (band <= seg.exit.s) {
+    leave_band(r, band);
+    seg.known = false;
+  } else if (seg.exit.edge < 0 || seg.exit.corner) {
+    finish(r, kHitVertex, kEventVertex, -1, seg.exit.edge < 0 ? real(0) : seg.exit.s);
+  } else if (is_wall(r.polygon, seg.exit.edge)) {
+    finish(r, kHitWall, kEventWall, seg.exit.edge, seg.exit.s);
+  } else {
+    advance(r, seg.exit.s);
+    cross_edge(r, seg.exit.edge, real(0));
+    seg.known = false;
+  }
+}
+
+// ---- A whole ray -----------------------------------------------------------------------------
+
+// A ray from outside the band sees the rooms laid out as their coordinates place them: it enters
+// the first polygon whose footprint it crosses at the band's top (or bottom).
+void enter_band(INOUT(Ray) r) {
+  bool above = r.o.z > params.height;
+  bool toward = above ? r.d.z < real(0) : r.d.z > real(0);
+  real s = toward ? ((above ? params.height : real(0)) - r.o.z) / r.d.z : params.max_distance;
+  if (s > params.max_distance) s = params.max_distance;  // the band is out of reach
+  vec3 q = r.o + s * r.d;
+  for (int k = 0; k < params.polygon_count && s < params.max_distance; ++k) {
+    if (!inside_polygon(k, vec2(q))) continue;
+    r.polygon = k;
+    if (!above && has(kFeatureFloor)) {  // the underside of the floor
+      finish(r, kHitFloor, kEventFloor, -1, s);
+      r.normal = vec3(real(0), real(0), real(-1));
+    } else {
+      advance(r, s);
+      record_event(kEventEnter, k, -1, -1, -1, -1, r.t, r.o);
+    }
+    return;
+  }
+  advance(r, s);
+  r.hit = kHitMiss;
+  r.done = true;
+  record_event(kEventMiss, -1, -1, -1, -1, -1, r.t, r.o);
+}
+
+// Follows a ray from `from` (in the coordinates of `polygon` when within the band) along `dir`.
+Ray march(int polygon, vec3 from, vec3 dir) {
+  Ray r;
+  r.polygon = polygon;
+  r.o = from;
+  r.d = normalize(dir);
+  r.t = real(0);
+  r.steps = 0;
+  r.crossings = 0;
+  r.hit = kHitMaxSteps;
+  r.done = false;
+  r.normal = vec3(real(0));
+  r.surface = vec3(real(0));
+  if (has(kFeaturePeriod)) {
+    r.o.z = mod(r.o.z, params.top);
+  } else if (r.o.z < real(0) || r.o.z > params.height) {
+    enter_band(r);
+  }
+  Relaxation x;
+  relax(x);
+  Segment seg;
+  seg.known = false;
+  seg.exit.s = real(kFar);
+  seg.exit.edge = -1;
+  seg.exit.corner = false;
+  seg.solids = real(kFar);
+  for (int i = 0; i < params.max_steps && !r.done; ++i) {
+    r.steps += 1;
+    if (params.method == kMethodAnalytic) {
+      analytic_step(r, seg);
+    } else {
+      sphere_step(r, x);
+    }
+  }
+  if (!r.done) finish(r, kHitMaxSteps, kEventMaxSteps, -1, real(0));
+  return r;
+}
+
+// ---- Appearance (DESIGN.md section 1) --------------------------------------------------------
+
+// The linear colour of a finished ray: its surface seen through `crossings` tinted walls.
+vec3 shade(Ray r) {
+  vec3 surface = vec3(params.background);  // miss, escape, max_distance
+  if (r.hit >= 0) {
+    surface = r.surface;
+  } else if (r.hit == kHitWall) {
+    surface = vec3(real(kWallGrey));
+  } else if (r.hit == kHitFloor) {
+    real check = floor(r.o.x / real(kFloorCheck)) + floor(r.o.y / real(kFloorCheck));
+    surface = vec3(real(mod(check, real(2)) >= real(1) ? kFloorDarkGrey : kWallGrey));
+  } else if (r.hit == kHitMaxSteps || r.hit == kHitVertex) {
+    surface = vec3(real(0));  // undecided rays show as black
+  }
+  real transmittance = pow(real(1) - params.wall_tint, real(r.crossings));
+  return transmittance * surface + (real(1) - transmittance) * vec3(params.fog);
+}

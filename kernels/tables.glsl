@@ -1,0 +1,41 @@
+// The flat tables a compiled scene hands every backend (GLSL subset, see glsl.hpp). Records are
+// made of 4-vectors so that their layout is the same in C++ and in a std430 shader buffer.
+//
+// polygons[p] = ivec4(first edge, edge count, first object, object count): the polygon's edges
+// and the solids in its room are contiguous runs of `edges` and `objects`.
+
+// One edge of a polygon, with everything a ray that reaches it needs.
+struct EdgeRecord {
+  vec4 segment;     // from vertex a (x, y) to vertex b (z, w), counterclockwise
+  vec4 line;        // outward unit normal n (x, y), dot(n, a) (z), 1 / |b - a|^2 (w)
+  vec4 map_linear;  // the gluing map's linear part, columns (x, y) and (z, w)
+  vec4 map_shift;   // its translation (x, y), 0, 0
+  ivec4 link;       // kind (kEdge*), destination polygon, destination edge, 0
+};
+
+// One solid in one polygon's room.
+struct ObjectRecord {
+  vec4 center;  // x, y, z; radius of a bounding sphere (w)
+  vec4 shape;   // sphere: radius; box: half-extents; hollow cube: size (xyz), hole (w);
+                // cylinder: radius, half-height
+  vec4 color;   // its own colour (xyz) when w > 0; otherwise the normal colours it
+  ivec4 info;   // solid (kSolid*), index in the hit AOV, 0, 0
+};
+
+// Per-frame constants: the march parameters (DESIGN.md section 3), the band and the look.
+struct KernelParams {
+  int method;      // kMethod*
+  int max_steps;
+  int polygon_count;
+  real eps;
+  real offset;
+  real max_distance;
+  real omega;
+  real height;            // the walls span [0, height]
+  real top;               // the period of a translation prism, else the height
+  real vertex_tolerance;  // analytic: an exit this close to a vertex meets the vertex
+  real normal_step;       // step of the finite differences that give object normals
+  real wall_tint;
+  vec4 fog;
+  vec4 background;
+};
