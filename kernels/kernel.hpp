@@ -4,6 +4,7 @@
 // feature set a scene uses.
 #pragma once
 
+#include <cstddef>
 #include <utility>
 #include <vector>
 
@@ -19,6 +20,11 @@ struct Tables {
   using vec4 = typename Types<real>::vec4;
 #include "kernels/tables.glsl"
 };
+
+// The parameters go to shaders as a std140 uniform block: 12 scalars, then 16-byte aligned vec4s.
+static_assert(offsetof(Tables<float>::KernelParams, fog) == 48 &&
+              sizeof(Tables<float>::KernelParams) == 80);
+static_assert(sizeof(Tables<float>::EdgeRecord) == 80 && sizeof(Tables<float>::ObjectRecord) == 64);
 
 // A transport event as the kernel reports it (EventKind numbering, kEvent*).
 struct KernelEvent {

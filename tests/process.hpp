@@ -14,6 +14,7 @@ struct ProcessResult {
   std::string out, err;
 };
 
+// argv[0] is found on PATH unless it is a path; throws std::runtime_error if it cannot be run.
 ProcessResult run_process(const std::vector<std::string>& argv, double timeout_seconds = 60.0);
 
 // Runs the flatmarch program under test with these arguments.

@@ -1,0 +1,252 @@
+// The kernel and its scene compiler against values worked out by hand: the tables of the torus,
+// the feature sets of scenes, the GLSL the shaders will compile, and each defined failure mode
+// (offset <= eps, max_steps, corners, grazing rays) ending with its documented event.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "backends/oracle/oracle.hpp"
+#include "backends/scalar/scalar.hpp"
+#include "kernels/compile.hpp"
+#include "kernels/shader_source.hpp"
+#include "scene/load.hpp"
+#include "tests/process.hpp"
+#include "tests/test_scenes.hpp"
+
+namespace flatmarch {
+namespace {
+
+Scene load(const std::string& json) {
+  return parse_scene(json, "test.json");
+}
+
+TEST(SceneCompiler, TorusTablesHoldItsEdgesAndMaps) {
+  // The square [0, 4]^2: edge 0 (bottom) is glued to edge 2 (top) by (0, 4), edge 1 (right) to
+  // edge 3 (left) by (-4, 0).
+  const auto t = kernel::compile_scene<double>(load(test::torus_json()), {});
+  EXPECT_EQ(t.features, 0u);  // no objects, mirrors, walls, period, floor or scaling
+  ASSERT_EQ(t.polygons.size(), 1u);
+  EXPECT_EQ(t.polygons[0], glm::ivec4(0, 4, 0, 0));
+  ASSERT_EQ(t.edges.size(), 4u);
+  EXPECT_TRUE(t.objects.empty());
+  const auto& bottom = t.edges[0];
+  EXPECT_EQ(bottom.segment, glm::dvec4(0, 0, 4, 0));
+  EXPECT_EQ(bottom.line, glm::dvec4(0, -1, 0, 1.0 / 16));  // outward normal, n.a, 1/|ab|^2
+  EXPECT_EQ(bottom.map_linear, glm::dvec4(1, 0, 0, 1));
+  EXPECT_EQ(bottom.map_shift, glm::dvec4(0, 4, 0, 0));
+  EXPECT_EQ(bottom.link, glm::ivec4(kEdgeGlued, 0, 2, 0));
+  const auto& right = t.edges[1];
+  EXPECT_EQ(right.line, glm::dvec4(1, 0, 4, 1.0 / 16));
+  EXPECT_EQ(right.map_shift, glm::dvec4(-4, 0, 0, 0));
+  EXPECT_EQ(right.link, glm::ivec4(kEdgeGlued, 0, 3, 0));
+  EXPECT_EQ(t.params.height, 2.0);
+  EXPECT_EQ(t.params.top, 2.0);
+  EXPECT_EQ(t.params.polygon_count, 1);
+}
+
+TEST(SceneCompiler, FeaturesAreWhatTheSceneUses) {
+  const auto features = [](const std::string& extra) {
+    return kernel::scene_features(load(test::torus_json(extra)));
+  };
+  EXPECT_EQ(features(R"("period": 3)"), kFeaturePeriod);
+  EXPECT_EQ(features(R"("floor": true)"), kFeatureFloor);
+  EXPECT_EQ(features(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
+                                      "radius": 0.5}])"),
+            kFeatureObjects);
+  EXPECT_EQ(features(R"("vertices": {"radius": 0.1})"), kFeatureObjects);
+  // A unit square with mirrors below and on the left, a wall on the right, the top glued to the
+  // bottom of a square twice its size by a similarity (scale 2).
+  const Scene mixed = load(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                            [[0, 2], [2, 2], [2, 4], [0, 4]]],
+                               "gluings": [{"edges": [[0, 2], [1, 0]], "map": "similarity"}],
+                               "boundaries": [{"edge": [0, 1], "boundary": "wall"}]})");
+  EXPECT_EQ(kernel::scene_features(mixed), kFeatureMirrors | kFeatureWalls | kFeatureScaled);
+  // Rotations and reflections are isometries: the cube and the Klein bottle need no scaling.
+  EXPECT_EQ(kernel::scene_features(load(test::cube_json())), 0u);
+}
+
+TEST(SceneCompiler, MarkersBecomeCylindersAtTheirCorners) {
+  // Every corner of the torus is the one vertex class; with a marker it gets a cylinder of the
+  // band's height at each of the square's four corners, numbered after the one object.
+  const Scene s = load(test::torus_json(
+      R"("objects": [{"type": "box", "polygon": 0, "center": [2, 2, 1], "half": [0.1, 0.2, 0.3]}],
+         "vertices": {"radius": 0.25})"));
+  const auto t = kernel::compile_scene<float>(s, {});
+  ASSERT_EQ(t.objects.size(), 5u);
+  EXPECT_EQ(t.polygons[0], glm::ivec4(0, 4, 0, 5));
+  EXPECT_EQ(t.objects[0].info, glm::ivec4(kSolidBox, 0, 0, 0));
+  EXPECT_FLOAT_EQ(t.objects[0].center.w, std::sqrt(0.01f + 0.04f + 0.09f));  // bounding radius
+  for (int k = 1; k < 5; ++k) {
+    EXPECT_EQ(t.objects[static_cast<size_t>(k)].info, glm::ivec4(kSolidCylinder, 1, 0, 0));
+    EXPECT_EQ(t.objects[static_cast<size_t>(k)].shape, glm::vec4(0.25f, 1.0f, 0, 0));
+  }
+  EXPECT_EQ(glm::vec2(t.objects[2].center), glm::vec2(4, 0));  // the corner of vertex 1
+}
+
+TEST(ShaderSource, IsValidGlslForEveryFeatureSet) {
+  bool found = false;
+  try {
+    found = test::run_process({"glslangValidator", "--version"}).exit_code == 0;
+  } catch (const std::runtime_error&) {
+  }
+  if (!found)
+    GTEST_SKIP() << "glslangValidator is not installed (ci/install-deps.sh installs glslang-tools)";
+  const std::filesystem::path dir = test::make_temp_dir();
+  for (uint features = 0; features < kFeatureCount; ++features) {
+    const std::filesystem::path shader = dir / ("kernel" + std::to_string(features) + ".comp");
+    std::ofstream(shader) << kernel::shader_source(features)
+                          << "layout(local_size_x = 1) in;\n"
+                             "void main() { Ray r = march(0, vec3(0.5), vec3(1, 0, 0)); }\n";
+    const test::ProcessResult r = test::run_process(
+        {"glslangValidator", "-V", shader.string(), "-o", (dir / "kernel.spv").string()});
+    EXPECT_EQ(r.exit_code, 0) << "features " << features << ":\n" << r.out << r.err;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// ---- Defined failure modes, on the torus [0, 4]^2 of height 2 --------------------------------
+
+Trace scalar_trace(const Scene& s, Vec3 from, Vec3 dir, MarchParams params, int max_events = 64) {
+  return ScalarBackend().trace(s, Ray{0, from, dir}, params, max_events);
+}
+
+MarchParams with(Method method, double eps = 1e-4, double offset = 2e-4, int max_steps = 1024) {
+  MarchParams p;
+  p.method = method;
+  p.eps = eps;
+  p.offset = offset;
+  p.max_steps = max_steps;
+  return p;
+}
+
+TEST(FailureModes, OffsetNotAboveEpsPingPongsUntilMaxSteps) {
+  // Along +x from (2, 2): the right edge is reached at t = 2. Placed offset <= eps inside the
+  // left edge, the point is within eps of it and crosses straight back, and so on.
+  const Scene s = load(test::torus_json());
+  for (Method m : {Method::sphere, Method::relaxed}) {
+    for (double offset : {0.5e-4, 0.99e-4}) {
+      const Trace tr = scalar_trace(s, {2, 2, 1}, {1, 0, 0}, with(m, 1e-4, offset, 200), 300);
+      ASSERT_GE(tr.events.size(), 3u);
+      EXPECT_EQ(tr.steps, 200);
+      EXPECT_EQ(tr.events.back().kind, EventKind::max_steps);
+      EXPECT_EQ(tr.events[0].edge, 1);
+      EXPECT_EQ(tr.events[1].edge, 3);  // straight back through the left edge
+      EXPECT_EQ(tr.events[2].edge, 1);
+      EXPECT_NEAR(tr.events.back().t, 2.0, 1e-4);  // it never gets further
+    }
+    // Just above eps the same ray goes on: it crosses the right edge every 4 units.
+    const Trace ok = scalar_trace(s, {2, 2, 1}, {1, 0, 0}, with(m, 1e-4, 1.5e-4), 3);
+    ASSERT_EQ(ok.events.size(), 3u);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(ok.events[static_cast<size_t>(k)].edge, 1);
+      EXPECT_NEAR(ok.events[static_cast<size_t>(k)].t, 2.0 + 4.0 * k, 1e-3);
+    }
+  }
+}
+
+TEST(FailureModes, MaxStepsEndsTheRayAfterExactlyThatManyIterations) {
+  const Scene s = load(test::torus_json());
+  // Analytic: one iteration per room, crossing the right edge at t = 2, 6, 10.
+  const Trace a = scalar_trace(s, {2, 2, 1}, {1, 0, 0}, with(Method::analytic, 1e-4, 2e-4, 3));
+  ASSERT_EQ(a.events.size(), 4u);
+  EXPECT_EQ(a.steps, 3);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(a.events[static_cast<size_t>(k)].t, 2.0 + 4.0 * k, 1e-6);
+  EXPECT_EQ(a.events[3].kind, EventKind::max_steps);
+  EXPECT_NEAR(a.events[3].t, 10.0, 1e-6);
+  // Sphere tracing: one step of 2 to the right edge, the crossing, then steps that double away
+  // from the left edge, 2e-4, 4e-4 and 8e-4, which end at x = 1.6e-3.
+  const Trace sp = scalar_trace(s, {2, 2, 1}, {1, 0, 0}, with(Method::sphere, 1e-4, 2e-4, 5));
+  EXPECT_EQ(sp.steps, 5);
+  ASSERT_EQ(sp.events.size(), 2u);
+  EXPECT_NEAR(sp.events[0].t, 2.0, 1e-6);
+  EXPECT_EQ(sp.events[1].kind, EventKind::max_steps);
+  EXPECT_NEAR(sp.events[1].t, 2.0014, 1e-6);
+  EXPECT_NEAR(sp.events[1].at.x, 1.6e-3, 1e-6);
+}
+
+TEST(FailureModes, ARayIntoACornerEndsAtTheVertex) {
+  // From (2, 2) along (1, 1): the corner (4, 4) at t = 2 sqrt 2.
+  const Scene s = load(test::torus_json());
+  const double corner = 2.0 * std::sqrt(2.0);
+  const Trace truth = OracleBackend().trace(s, Ray{0, {2, 2, 1}, {1, 1, 0}}, {}, 8);
+  ASSERT_EQ(truth.events.size(), 1u);
+  EXPECT_EQ(truth.events[0].kind, EventKind::vertex);
+  for (Method m : {Method::sphere, Method::relaxed, Method::analytic}) {
+    const Trace tr = scalar_trace(s, {2, 2, 1}, {1, 1, 0}, with(m));
+    ASSERT_EQ(tr.events.size(), 1u) << to_string(m);
+    EXPECT_EQ(tr.events[0].kind, EventKind::vertex) << to_string(m);
+    // Sphere tracing stops once within eps of both edges: up to eps sqrt 2 before the corner.
+    EXPECT_NEAR(tr.events[0].t, corner - 0.75e-4, 0.75e-4) << to_string(m);
+    EXPECT_LE(tr.steps, 64);
+  }
+  // Sphere tracing cannot tell a corner from a ray passing within eps of it. 3e-5 beside the
+  // diagonal, the distance to the top edge shrinks by 1 - 1/sqrt 2 a step, from 2 to 3.2e-5
+  // after 9 steps, when the right edge is 6.2e-5 away: both within eps, a vertex. The oracle
+  // (and the analytic method) cross the top edge 3e-5 from the corner.
+  const Vec3 beside{2, 2 + 3e-5, 1};
+  EXPECT_EQ(scalar_trace(s, beside, {1, 1, 0}, with(Method::sphere)).events[0].kind,
+            EventKind::vertex);
+  const Trace analytic = scalar_trace(s, beside, {1, 1, 0}, with(Method::analytic), 1);
+  EXPECT_EQ(analytic.events[0].kind, EventKind::gluing);
+  EXPECT_EQ(analytic.events[0].edge, 2);
+}
+
+TEST(FailureModes, AGrazingRayCreepsAlongTheWallUntilMaxSteps) {
+  const Scene s = load(test::torus_json());
+  // Along +x, 1.5 eps above the bottom edge: every sphere step is 1.5e-4 long, so 1024 steps
+  // cover 0.154 of the 3.5 to the right edge.
+  const Trace creep = scalar_trace(s, {0.5, 1.5e-4, 1}, {1, 0, 0}, with(Method::sphere));
+  ASSERT_EQ(creep.events.size(), 1u);
+  EXPECT_EQ(creep.events[0].kind, EventKind::max_steps);
+  EXPECT_EQ(creep.steps, 1024);
+  EXPECT_NEAR(creep.events[0].t, 1024 * 1.5e-4, 1e-4);
+  // Within eps of the edge it runs along, the ray is carried through it: into the top of the
+  // square, placed offset below the top edge, where it creeps on.
+  const Trace carried = scalar_trace(s, {0.5, 0.5e-4, 1}, {1, 0, 0}, with(Method::sphere));
+  ASSERT_EQ(carried.events.size(), 2u);
+  EXPECT_EQ(carried.events[0].kind, EventKind::gluing);
+  EXPECT_EQ(carried.events[0].edge, 0);
+  EXPECT_EQ(carried.events[0].t, 0.0);
+  EXPECT_EQ(carried.events[1].kind, EventKind::max_steps);
+  EXPECT_NEAR(carried.events[1].at.y, 4.0 - 2e-4, 1e-6);
+  // The analytic method follows the oracle: out through the right edge at t = 3.5.
+  const Trace exact = scalar_trace(s, {0.5, 1.5e-4, 1}, {1, 0, 0}, with(Method::analytic), 1);
+  EXPECT_EQ(exact.events[0].edge, 1);
+  EXPECT_NEAR(exact.events[0].t, 3.5, 1e-6);
+}
+
+TEST(Kernel, AnalyticInFloat64FollowsTheOracleExactly) {
+  // A ray through the L-shape that crosses 40 rooms and no object: in float64 the analytic
+  // method computes the same exit points as the oracle, up to rounding.
+  const Scene s = load_scene(std::filesystem::path(FLATMARCH_SOURCE_DIR) / "scenes/l_shape.json");
+  const Ray ray{0, {0.3, 1.7, 1.0}, {0.8, 0.6526979, 0.001}};
+  MarchParams p = with(Method::analytic);
+  p.precision = Precision::f64;
+  const Trace truth = OracleBackend().trace(s, ray, {}, 40);
+  const Trace got = ScalarBackend().trace(s, ray, p, 40);
+  ASSERT_EQ(truth.events.size(), 40u);
+  ASSERT_EQ(got.events.size(), truth.events.size());
+  for (size_t k = 0; k < truth.events.size(); ++k) {
+    EXPECT_EQ(got.events[k].kind, truth.events[k].kind) << k;
+    EXPECT_EQ(got.events[k].edge, truth.events[k].edge) << k;
+    EXPECT_NEAR(got.events[k].t, truth.events[k].t, 1e-9) << k;
+    EXPECT_NEAR(glm::distance(got.events[k].at, truth.events[k].at), 0.0, 1e-9) << k;
+  }
+}
+
+TEST(Kernel, ShadesLikeTheOracle) {
+  // Same scene, same rays: in float64 the analytic method's colours are the oracle's.
+  const Scene s = load_scene(std::filesystem::path(FLATMARCH_SOURCE_DIR) / "scenes/torus.json");
+  MarchParams p = with(Method::analytic);
+  p.precision = Precision::f64;
+  const Frame truth = OracleBackend().render(s, s.camera, 32, 18, {}, {});
+  const Frame got = ScalarBackend().render(s, s.camera, 32, 18, p, {});
+  size_t close = 0;
+  for (size_t k = 0; k < truth.rgb.size(); ++k) close += std::abs(truth.rgb[k] - got.rgb[k]) < 1e-3f;
+  EXPECT_GE(static_cast<double>(close) / static_cast<double>(truth.rgb.size()), 0.99);
+}
+
+}  // namespace
+}  // namespace flatmarch
