@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <sstream>
 
 #include "backends/oracle/oracle.hpp"
@@ -116,6 +117,11 @@ const Backend& MarchOptions::resolve() {
   if (!(params.max_distance > 0.0) || !std::isfinite(params.max_distance))
     throw UsageError("--max-distance: must be a positive number");
   if (!(params.omega >= 1.0 && params.omega < 2.0)) throw UsageError("--omega: must lie in [1, 2)");
+  if ((params.method == Method::sphere || params.method == Method::relaxed) &&
+      params.offset <= params.eps)
+    std::cerr << "warning: --offset " << params.offset << " is not above --eps " << params.eps
+              << ": a ray placed that close to the edge it came through crosses back, so every "
+                 "ray that reaches a gluing ends with max_steps\n";
   return *b;
 }
 

@@ -97,7 +97,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
       r.segment = vec4(real(a.x), real(a.y), real(b.x), real(b.y));
       r.line = vec4(real(edge.normal.x), real(edge.normal.y), real(glm::dot(edge.normal, a)),
                     real(1.0 / glm::dot(b - a, b - a)));
-      r.link.x = edge.kind == EdgeKind::glued   ? kEdgeGlued
+      r.link.x = edge.kind == EdgeKind::glued    ? kEdgeGlued
                  : edge.kind == EdgeKind::mirror ? kEdgeMirror
                                                  : kEdgeWall;
       if (edge.kind == EdgeKind::glued) {

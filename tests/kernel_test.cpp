@@ -244,7 +244,8 @@ TEST(Kernel, ShadesLikeTheOracle) {
   const Frame truth = OracleBackend().render(s, s.camera, 32, 18, {}, {});
   const Frame got = ScalarBackend().render(s, s.camera, 32, 18, p, {});
   size_t close = 0;
-  for (size_t k = 0; k < truth.rgb.size(); ++k) close += std::abs(truth.rgb[k] - got.rgb[k]) < 1e-3f;
+  for (size_t k = 0; k < truth.rgb.size(); ++k)
+    close += std::abs(truth.rgb[k] - got.rgb[k]) < 1e-3f;
   EXPECT_GE(static_cast<double>(close) / static_cast<double>(truth.rgb.size()), 0.99);
 }
 

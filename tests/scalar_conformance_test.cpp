@@ -36,9 +36,10 @@ const Scene& scene_named(const std::string& name) {
   static std::map<std::string, Scene> cache;
   auto it = cache.find(name);
   if (it == cache.end())
-    it = cache
-             .emplace(name, load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "scenes" / (name + ".json")))
-             .first;
+    it =
+        cache
+            .emplace(name, load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "scenes" / (name + ".json")))
+            .first;
   return it->second;
 }
 
@@ -73,8 +74,7 @@ std::vector<Ray> generic_rays(const Scene& scene) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const double top = scene.period ? *scene.period : scene.height;
   std::vector<Ray> rays;
-  for (int attempt = 0; attempt < 500 && static_cast<int>(rays.size()) < kRaysPerScene;
-       ++attempt) {
+  for (int attempt = 0; attempt < 500 && static_cast<int>(rays.size()) < kRaysPerScene; ++attempt) {
     const int p = static_cast<int>(unit(rng) * static_cast<double>(scene.polygons.size()));
     const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
     Vec2 lo = polygon.vertices[0], hi = lo;
@@ -217,6 +217,27 @@ TEST_P(ScalarConformance, HitAovAgreesWithTheOracle) {
   // A named exception: below 99% only because rays ran out of steps where the oracle went on.
   EXPECT_LT(fraction, 0.99) << "no longer an exception: take it off the list";
   EXPECT_GE(fraction + static_cast<double>(gave_up) / pixels, 0.99);
+}
+
+double mean_steps(const Scene& scene, Method method) {
+  MarchParams params;
+  params.method = method;
+  const Frame f = ScalarBackend().render(scene, scene.camera, 320, 180, params, {});
+  double sum = 0.0;
+  for (float s : f.steps) sum += s;
+  return sum / static_cast<double>(f.steps.size());
+}
+
+TEST(ScalarSteps, AnalyticTakesTenTimesFewerStepsThanSphereOnTranslationSurfaces) {
+  // Steps are deterministic, so this holds on any machine (bench/kernel_bench reports them too).
+  for (const std::string name : {"l_shape", "double_pentagon"}) {
+    const Scene& scene = scene_named(name);
+    const double sphere = mean_steps(scene, Method::sphere);
+    const double analytic = mean_steps(scene, Method::analytic);
+    std::cout << name << ": mean steps per ray at 320x180, sphere " << sphere << ", analytic "
+              << analytic << ", ratio " << sphere / analytic << "\n";
+    EXPECT_GE(sphere / analytic, 10.0) << name;
+  }
 }
 
 std::vector<Case> cases() {

@@ -14,8 +14,8 @@ Frame render_in(const Scene& scene, const Camera& camera, int width, int height,
                 const MarchParams& params, const Progress& progress) {
   using vec3 = glm::vec<3, real>;
   const kernel::SceneTables<real> tables = kernel::compile_scene<real>(scene, params);
-  const CameraBasis<real> basis = camera_basis<real>(
-      real(camera.yaw_deg), real(camera.pitch_deg), real(camera.fov_deg), width, height);
+  const CameraBasis<real> basis = camera_basis<real>(real(camera.yaw_deg), real(camera.pitch_deg),
+                                                     real(camera.fov_deg), width, height);
   const vec3 from(camera.position);
   Frame frame(width, height);
   kernel::with_kernel<real>(tables, [&](auto& k) {

@@ -1,0 +1,77 @@
+// `flatmarch render` and `flatmarch trace` with the scalar backend work for every gallery scene
+// and method, and say so when the parameters guarantee a failure.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/load.hpp"
+#include "tests/process.hpp"
+
+namespace flatmarch {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> gallery() {
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(fs::path(FLATMARCH_SOURCE_DIR) / "scenes"))
+    if (entry.path().extension() == ".json") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string text(Vec3 v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v.x << "," << v.y << "," << v.z;
+  return s.str();
+}
+
+TEST(CliScalar, RendersAndTracesEveryGalleryScene) {
+  // Each method on a third of the scenes keeps the run short; the conformance tests render
+  // every scene with every method through the same backend.
+  const fs::path dir = test::make_temp_dir();
+  const std::string methods[] = {"sphere", "relaxed", "analytic"};
+  const std::vector<std::string> scenes = gallery();
+  for (size_t k = 0; k < scenes.size(); ++k) {
+    const std::string& scene = scenes[k];
+    const std::string& method = methods[k % 3];
+    const fs::path out = dir / (fs::path(scene).stem().string() + ".png");
+    const auto r = test::run_flatmarch({"render", scene, "-o", out.string(), "--size", "32x18",
+                                        "--backend", "scalar", "--method", method});
+    ASSERT_EQ(r.exit_code, 0) << scene << " " << method << ": " << r.err;
+    EXPECT_TRUE(fs::exists(out));
+    EXPECT_TRUE(fs::exists(fs::path(out).replace_extension(".exr")));
+    // A ray from the scene's camera.
+    const Camera camera = load_scene(scene).camera;
+    const auto t =
+        test::run_flatmarch({"trace", scene, "--polygon", std::to_string(camera.polygon), "--from",
+                             text(camera.position), "--dir", "1,0.3,-0.2", "--backend", "scalar",
+                             "--method", methods[(k + 1) % 3], "--precision", "f64"});
+    ASSERT_EQ(t.exit_code, 0) << scene << ": " << t.err;
+    const nlohmann::json trace = nlohmann::json::parse(t.out);
+    EXPECT_EQ(trace["backend"], "scalar");
+    EXPECT_EQ(trace["method"], methods[(k + 1) % 3]);
+    EXPECT_FALSE(trace["events"].empty());
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CliScalar, WarnsThatOffsetNotAboveEpsPingPongs) {
+  const std::string torus = FLATMARCH_SOURCE_DIR "/scenes/torus.json";
+  const auto r =
+      test::run_flatmarch({"trace", torus, "--from", "2,2,1", "--dir", "1,0,0", "--backend",
+                           "scalar", "--eps", "1e-3", "--offset", "1e-3", "--max-steps", "50"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: --offset"), std::string::npos) << r.err;
+  const nlohmann::json trace = nlohmann::json::parse(r.out);
+  EXPECT_EQ(trace["events"].back()["kind"], "max_steps");
+  EXPECT_EQ(trace["steps"], 50);
+}
+
+}  // namespace
+}  // namespace flatmarch
