@@ -1,0 +1,73 @@
+// How the scalar backend runs the kernel in one precision: a frame pixel by pixel, or one ray
+// with its events. Instantiated once per precision (scalar_f32.cpp, scalar_f64.cpp), so the
+// kernel's 64 specialisations of each compile in parallel.
+#pragma once
+
+#include "backends/backend.hpp"
+#include "kernels/camera.hpp"
+#include "kernels/compile.hpp"
+
+namespace flatmarch::scalar {
+
+template <typename real>
+Frame render_in(const Scene& scene, const Camera& camera, int width, int height,
+                const MarchParams& params, const Progress& progress) {
+  using vec3 = glm::vec<3, real>;
+  const kernel::SceneTables<real> tables = kernel::compile_scene<real>(scene, params);
+  const CameraBasis<real> basis = camera_basis<real>(real(camera.yaw_deg), real(camera.pitch_deg),
+                                                     real(camera.fov_deg), width, height);
+  const vec3 from(camera.position);
+  Frame frame(width, height);
+  kernel::with_kernel<real>(tables, [&](auto& k) {
+    constexpr int kRowsPerReport = 8;
+    for (int j = 0; j < height; ++j) {
+      for (int i = 0; i < width; ++i) {
+        const auto r = k.march(camera.polygon, from, camera_ray(basis, i, j, width, height));
+        const vec3 c = k.shade(r);
+        const size_t px = frame.pixel(i, j);
+        for (int n = 0; n < 3; ++n)
+          frame.rgb[3 * px + static_cast<size_t>(n)] = static_cast<float>(c[n]);
+        frame.steps[px] = static_cast<float>(r.steps);
+        frame.crossings[px] = static_cast<float>(r.crossings);
+        frame.hit[px] = static_cast<float>(r.hit);
+        frame.t[px] = static_cast<float>(r.t);
+      }
+      if (progress && ((j + 1) % kRowsPerReport == 0 || j + 1 == height))
+        progress(static_cast<double>(j + 1) / height);
+    }
+  });
+  return frame;
+}
+
+template <typename real>
+Trace trace_in(const Scene& scene, const Ray& ray, const MarchParams& params, int max_events) {
+  using vec3 = glm::vec<3, real>;
+  const kernel::SceneTables<real> tables = kernel::compile_scene<real>(scene, params);
+  std::vector<kernel::KernelEvent> events;
+  Trace trace;
+  kernel::with_kernel<real>(tables, [&](auto& k) {
+    k.events = &events;
+    k.max_events = max_events;
+    trace.steps = k.march(ray.polygon, vec3(ray.from), vec3(ray.dir)).steps;
+  });
+  for (const kernel::KernelEvent& e : events)
+    trace.events.push_back({.kind = static_cast<EventKind>(e.kind),
+                            .polygon = e.polygon,
+                            .edge = e.edge,
+                            .to_polygon = e.to_polygon,
+                            .to_edge = e.to_edge,
+                            .object = e.object,
+                            .t = e.t,
+                            .at = e.at});
+  return trace;
+}
+
+// Compiled in scalar_f32.cpp and scalar_f64.cpp only.
+extern template Frame render_in<float>(const Scene&, const Camera&, int, int, const MarchParams&,
+                                       const Progress&);
+extern template Frame render_in<double>(const Scene&, const Camera&, int, int, const MarchParams&,
+                                        const Progress&);
+extern template Trace trace_in<float>(const Scene&, const Ray&, const MarchParams&, int);
+extern template Trace trace_in<double>(const Scene&, const Ray&, const MarchParams&, int);
+
+}  // namespace flatmarch::scalar
