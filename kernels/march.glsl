@@ -55,10 +55,10 @@ void finish(INOUT(Ray) r, int hit, int event, int edge, real s) {
 // Whether the horizontal ray from p in +x crosses the edge from a to a + ab (crossing number).
 bool crosses(vec2 a, vec2 ab, vec2 p) {
   vec2 ap = p - a;
-  bool below = p.y >= a.y;
-  bool above = p.y < a.y + ab.y;
+  bool over_a = p.y >= a.y;
+  bool under_b = p.y < a.y + ab.y;
   bool left = ab.x * ap.y > ab.y * ap.x;
-  return (below && above && left) || (!below && !above && !left);
+  return (over_a && under_b && left) || (!over_a && !under_b && !left);
 }
 
 bool inside_polygon(int polygon, vec2 p) {
@@ -291,6 +291,7 @@ struct Relaxation {
   real last_step;    // how far the previous step went
 };
 
+// Over-relaxation starts afresh in each room: after every crossing and period wrap.
 void relax(INOUT(Relaxation) x) {
   x.omega = params.method == kMethodRelaxed ? params.omega : real(1);
   x.last_radius = real(0);
