@@ -74,6 +74,15 @@ struct Frame {
   size_t pixel(int i, int j) const {
     return static_cast<size_t>(j) * static_cast<size_t>(width) + static_cast<size_t>(i);
   }
+  // Writes pixel (i, j): its linear colour and how its ray ended.
+  void set(int i, int j, Vec3 color, int ray_steps, int ray_crossings, int ray_hit, double ray_t) {
+    const size_t px = pixel(i, j);
+    for (int n = 0; n < 3; ++n) rgb[3 * px + static_cast<size_t>(n)] = static_cast<float>(color[n]);
+    steps[px] = static_cast<float>(ray_steps);
+    crossings[px] = static_cast<float>(ray_crossings);
+    hit[px] = static_cast<float>(ray_hit);
+    t[px] = static_cast<float>(ray_t);
+  }
 };
 
 struct Availability {

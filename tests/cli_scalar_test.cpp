@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -22,13 +21,6 @@ std::vector<std::string> gallery() {
     if (entry.path().extension() == ".json") files.push_back(entry.path().string());
   std::sort(files.begin(), files.end());
   return files;
-}
-
-std::string text(Vec3 v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v.x << "," << v.y << "," << v.z;
-  return s.str();
 }
 
 TEST(CliScalar, RendersAndTracesEveryGalleryScene) {
@@ -50,8 +42,8 @@ TEST(CliScalar, RendersAndTracesEveryGalleryScene) {
     const Camera camera = load_scene(scene).camera;
     const auto t =
         test::run_flatmarch({"trace", scene, "--polygon", std::to_string(camera.polygon), "--from",
-                             text(camera.position), "--dir", "1,0.3,-0.2", "--backend", "scalar",
-                             "--method", methods[(k + 1) % 3], "--precision", "f64"});
+                             test::vec3_arg(camera.position), "--dir", "1,0.3,-0.2", "--backend",
+                             "scalar", "--method", methods[(k + 1) % 3], "--precision", "f64"});
     ASSERT_EQ(t.exit_code, 0) << scene << ": " << t.err;
     const nlohmann::json trace = nlohmann::json::parse(t.out);
     EXPECT_EQ(trace["backend"], "scalar");

@@ -28,6 +28,13 @@ std::string slurp(const std::string& path) {
 
 }  // namespace
 
+std::string vec3_arg(Vec3 v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v.x << "," << v.y << "," << v.z;
+  return s.str();
+}
+
 std::string make_temp_dir() {
   std::string pattern = (std::filesystem::temp_directory_path() / "flatmarch-test-XXXXXX").string();
   if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "scene/geometry.hpp"
+
 namespace flatmarch::test {
 
 struct ProcessResult {
@@ -19,6 +21,9 @@ ProcessResult run_process(const std::vector<std::string>& argv, double timeout_s
 
 // Runs the flatmarch program under test with these arguments.
 ProcessResult run_flatmarch(const std::vector<std::string>& args, double timeout_seconds = 60.0);
+
+// A vector as a command-line argument X,Y,Z, with every digit a double has.
+std::string vec3_arg(Vec3 v);
 
 // A fresh empty directory under the system's temporary directory.
 std::string make_temp_dir();

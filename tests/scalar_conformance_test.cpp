@@ -9,12 +9,12 @@
 #include <map>
 #include <random>
 #include <set>
-#include <sstream>
 
 #include "backends/oracle/oracle.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "kernels/camera.hpp"
 #include "scene/load.hpp"
+#include "tests/process.hpp"
 
 namespace flatmarch {
 namespace {
@@ -103,13 +103,6 @@ std::string describe(const Event& e) {
   return s;
 }
 
-std::string text(Vec3 v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v.x << "," << v.y << "," << v.z;
-  return s.str();
-}
-
 // Scenes where sphere tracing at the default max_steps (1024) cannot follow every ray to the
 // default max_distance (100): rays near the horizon cross a room every unit or two and spend
 // 10-20 steps closing in on each wall, and in translation prisms nothing escapes, so every ray
@@ -149,8 +142,8 @@ TEST_P(ScalarConformance, GenericRaysFollowTheOraclesEdgeSequence) {
     for (size_t i = 0; i < std::min(truth.events.size(), got.events.size()); ++i) {
       const Event &a = truth.events[i], &b = got.events[i];
       ASSERT_EQ(describe(b), describe(a))
-          << "event " << i << " of the ray from " << text(rays[k].from) << " along "
-          << text(rays[k].dir) << " in polygon " << rays[k].polygon;
+          << "event " << i << " of the ray from " << test::vec3_arg(rays[k].from) << " along "
+          << test::vec3_arg(rays[k].dir) << " in polygon " << rays[k].polygon;
       EXPECT_EQ(b.to_polygon, a.to_polygon);
       EXPECT_EQ(b.to_edge, a.to_edge);
       EXPECT_NEAR(b.t, a.t, 1e-2 * scene.scale) << "ray " << k << " event " << i;

@@ -332,14 +332,7 @@ Frame OracleBackend::render(const Scene& scene, const Camera& camera, int width,
       for (int i = 0; i < width; ++i) {
         const Ray ray{camera.polygon, camera.position, camera_ray(basis, i, j, width, height)};
         const RayEnd end = oracle_trace(scene, ray, params).end;
-        const size_t px = frame.pixel(i, j);
-        const Vec3 c = oracle_color(scene, end);
-        for (int k = 0; k < 3; ++k)
-          frame.rgb[3 * px + static_cast<size_t>(k)] = static_cast<float>(c[k]);
-        frame.steps[px] = static_cast<float>(end.steps);
-        frame.crossings[px] = static_cast<float>(end.crossings);
-        frame.hit[px] = static_cast<float>(end.hit);
-        frame.t[px] = static_cast<float>(end.t);
+        frame.set(i, j, oracle_color(scene, end), end.steps, end.crossings, end.hit, end.t);
       }
     });
     if (progress) progress(static_cast<double>(std::min(band + kRowsPerReport, height)) / height);

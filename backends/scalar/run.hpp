@@ -23,14 +23,7 @@ Frame render_in(const Scene& scene, const Camera& camera, int width, int height,
     for (int j = 0; j < height; ++j) {
       for (int i = 0; i < width; ++i) {
         const auto r = k.march(camera.polygon, from, camera_ray(basis, i, j, width, height));
-        const vec3 c = k.shade(r);
-        const size_t px = frame.pixel(i, j);
-        for (int n = 0; n < 3; ++n)
-          frame.rgb[3 * px + static_cast<size_t>(n)] = static_cast<float>(c[n]);
-        frame.steps[px] = static_cast<float>(r.steps);
-        frame.crossings[px] = static_cast<float>(r.crossings);
-        frame.hit[px] = static_cast<float>(r.hit);
-        frame.t[px] = static_cast<float>(r.t);
+        frame.set(i, j, Vec3(k.shade(r)), r.steps, r.crossings, r.hit, r.t);
       }
       if (progress && ((j + 1) % kRowsPerReport == 0 || j + 1 == height))
         progress(static_cast<double>(j + 1) / height);
