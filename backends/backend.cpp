@@ -3,8 +3,10 @@
 #include <array>
 #include <utility>
 
+#include "backends/kernel_trace.hpp"
 #include "backends/oracle/oracle.hpp"
 #include "backends/scalar/scalar.hpp"
+#include "backends/simd/simd.hpp"
 
 namespace flatmarch {
 
@@ -64,11 +66,36 @@ Frame::Frame(int w, int h)
       hit(steps.size()),
       t(steps.size()) {}
 
+Trace kernel_trace(const std::vector<kernel::KernelEvent>& events, int steps) {
+  Trace trace;
+  trace.steps = steps;
+  for (const kernel::KernelEvent& e : events)
+    trace.events.push_back({.kind = static_cast<EventKind>(e.kind),
+                            .polygon = e.polygon,
+                            .edge = e.edge,
+                            .to_polygon = e.to_polygon,
+                            .to_edge = e.to_edge,
+                            .object = e.object,
+                            .t = e.t,
+                            .at = e.at});
+  return trace;
+}
+
+namespace {
+constexpr std::array<const char*, 3> kBackendNames{"oracle", "scalar", "simd"};
+}  // namespace
+
+std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOptions& options) {
+  if (name == "oracle") return std::make_unique<OracleBackend>();
+  if (name == "scalar") return std::make_unique<ScalarBackend>();
+  if (name == "simd") return std::make_unique<SimdBackend>(options);
+  return nullptr;
+}
+
 const std::vector<std::unique_ptr<Backend>>& backends() {
   static const std::vector<std::unique_ptr<Backend>> all = [] {
     std::vector<std::unique_ptr<Backend>> v;
-    v.push_back(std::make_unique<OracleBackend>());
-    v.push_back(std::make_unique<ScalarBackend>());
+    for (const char* name : kBackendNames) v.push_back(make_backend(name, {}));
     return v;
   }();
   return all;

@@ -90,6 +90,12 @@ struct Availability {
   std::string reason;  // why not, when unavailable
 };
 
+// How a backend runs, where it has a choice (command-line options --isa, --threads).
+struct BackendOptions {
+  std::string isa;  // simd: the instruction set (see `flatmarch backends`); empty: the best here
+  int threads = 0;  // simd: worker threads; 0: all cores
+};
+
 // Called now and then during long work with the fraction done, in [0, 1].
 using Progress = std::function<void(double)>;
 
@@ -101,6 +107,8 @@ class Backend {
   virtual Availability availability() const = 0;
   // Methods this backend runs; `oracle` runs only Method::oracle.
   virtual std::vector<Method> methods() const = 0;
+  // Precisions it marches in.
+  virtual std::vector<Precision> precisions() const { return {Precision::f32, Precision::f64}; }
 
   virtual Frame render(const Scene& scene, const Camera& camera, int width, int height,
                        const MarchParams& params, const Progress& progress) const = 0;
@@ -109,8 +117,10 @@ class Backend {
                       int max_events) const = 0;
 };
 
-// All backends this build knows, available here or not.
+// All backends this build knows, available here or not, with default options.
 const std::vector<std::unique_ptr<Backend>>& backends();
 const Backend* find_backend(const std::string& name);
+// A backend by name with the given options; null if there is none of that name.
+std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOptions& options);
 
 }  // namespace flatmarch

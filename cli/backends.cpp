@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/backend.hpp"
+#include "backends/simd/simd.hpp"
 #include "cli/commands.hpp"
 
 namespace flatmarch::cli {
@@ -24,6 +25,7 @@ void add_backends(CLI::App& app) {
                       {"reason", a.reason},
                       {"methods", methods},
                       {"description", b->description()}});
+      if (b->name() == "simd") list.back()["isas"] = simd::isa_names(true);
     }
     if (*json) {
       std::cout << list.dump(2) << "\n";
@@ -41,6 +43,9 @@ void add_backends(CLI::App& app) {
                       : "unavailable: " + b["reason"].get<std::string>())
                       .c_str());
     }
+    std::string isas;
+    for (const std::string& name : simd::isa_names(true)) isas += (isas.empty() ? "" : ", ") + name;
+    std::printf("\nsimd instruction sets this CPU runs (--isa), best first: %s\n", isas.c_str());
   });
 }
 

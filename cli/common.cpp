@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "backends/oracle/oracle.hpp"
+#include "backends/simd/simd.hpp"
 
 namespace flatmarch::cli {
 
@@ -64,11 +65,15 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
   return {w, h};
 }
 
-void MarchOptions::add_to(CLI::App& app) {
+void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
+                          const std::string& fallback) {
+  default_backend = default_name;
+  fallback_ = fallback;
   std::string names;
   for (const auto& b : backends()) names += (names.empty() ? "" : ", ") + b->name();
-  app.add_option("--backend", backend, "Backend: " + names + " (see `flatmarch backends`)")
-      ->capture_default_str();
+  app.add_option("--backend", backend,
+                 "Backend: " + names + " (see `flatmarch backends`); default: " + default_name +
+                     (fallback != default_name ? " where available, else " + fallback : ""));
   app.add_option("--method", method,
                  "Method: sphere, relaxed, analytic, oracle (default: the backend's first)");
   app.add_option("--eps", params.eps, "Hit threshold")->capture_default_str();
@@ -79,14 +84,33 @@ void MarchOptions::add_to(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--omega", params.omega, "Over-relaxation factor of the relaxed method")
       ->capture_default_str();
-  app.add_option("--precision", precision, "f32 or f64 (f64 on CPU backends)")
+  app.add_option("--precision", precision, "f32 or f64 (f64 on the oracle and scalar backends)")
+      ->capture_default_str();
+  app.add_option("--isa", backend_options.isa,
+                 "simd: the instruction set, one of those `flatmarch backends` lists (default: "
+                 "the best this CPU runs)");
+  app.add_option("--threads", backend_options.threads, "simd: worker threads (0: all cores)")
       ->capture_default_str();
 }
 
 const Backend& MarchOptions::resolve() {
-  const Backend* b = find_backend(backend);
-  if (!b)
+  if (backend.empty()) {
+    const Backend* preferred = find_backend(default_backend);
+    backend = preferred && preferred->availability().available ? default_backend : fallback_;
+  }
+  if (backend_options.threads < 0) throw UsageError("--threads: must be 0 (all cores) or more");
+  const std::vector<std::string> isas = simd::isa_names(false);
+  if (!backend_options.isa.empty() &&
+      std::find(isas.begin(), isas.end(), backend_options.isa) == isas.end()) {
+    std::string list;
+    for (const std::string& name : isas) list += (list.empty() ? "" : ", ") + name;
+    throw UsageError("--isa: unknown instruction set \"" + backend_options.isa + "\" (" + list +
+                     ")");
+  }
+  made_ = make_backend(backend, backend_options);
+  if (!made_)
     throw UsageError("--backend: unknown backend \"" + backend + "\" (see `flatmarch backends`)");
+  const Backend* b = made_.get();
   const Availability a = b->availability();
   if (!a.available)
     throw UnavailableError("backend " + backend + " is unavailable here: " + a.reason);
@@ -108,6 +132,9 @@ const Backend& MarchOptions::resolve() {
     params.precision = Precision::f64;
   else
     throw UsageError("--precision: expected f32 or f64, got \"" + precision + "\"");
+  const std::vector<Precision> precisions = b->precisions();
+  if (std::find(precisions.begin(), precisions.end(), params.precision) == precisions.end())
+    throw UsageError("--precision: backend " + backend + " does not march in " + precision);
   if (!(params.eps > 0.0) || !std::isfinite(params.eps))
     throw UsageError("--eps: must be a positive number");
   if (!(params.offset > 0.0) || !std::isfinite(params.offset))

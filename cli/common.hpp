@@ -1,6 +1,7 @@
 // What the subcommands share: errors with their exit codes, march options, argument parsing.
 #pragma once
 
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -28,15 +29,23 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
 
 // The backend and march parameters of render and trace (DESIGN.md section 3).
 struct MarchOptions {
-  std::string backend = "oracle";
+  std::string backend;  // empty: default_backend
+  std::string default_backend = "oracle";
   std::string method;  // empty: the backend's first method
   MarchParams params;
   std::string precision = "f32";
+  BackendOptions backend_options;
 
-  void add_to(CLI::App& app);
-  // Looks the backend up (UsageError if unknown, UnavailableError if unavailable here) and
-  // checks the parameters against it.
+  // `fallback`: the backend when default_backend is unavailable here.
+  void add_to(CLI::App& app, const std::string& default_name = "oracle",
+              const std::string& fallback = "oracle");
+  // Makes the backend (UsageError if unknown, UnavailableError if unavailable here) and checks
+  // the parameters against it.
   const Backend& resolve();
+
+ private:
+  std::string fallback_;
+  std::unique_ptr<Backend> made_;
 };
 
 // Camera overrides of render (DESIGN.md section 5).

@@ -24,7 +24,7 @@ void add_render(CLI::App& app) {
   cmd->add_option("-o,--output", o->out, "Output PNG; the EXR goes beside it")->required();
   cmd->add_option("--size", o->size, "Image size WxH")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No progress or summary on stderr");
-  o->march.add_to(*cmd);
+  o->march.add_to(*cmd, "simd", "scalar");
   o->camera.add_to(*cmd);
   cmd->callback([o] {
     const auto [w, h] = parse_size("--size", o->size);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/load.hpp"
+#include "tests/gallery.hpp"
 #include "tests/process.hpp"
 
 namespace flatmarch {
@@ -15,20 +16,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> gallery() {
-  std::vector<std::string> files;
-  for (const auto& entry : fs::directory_iterator(fs::path(FLATMARCH_SOURCE_DIR) / "scenes"))
-    if (entry.path().extension() == ".json") files.push_back(entry.path().string());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 TEST(CliScalar, RendersAndTracesEveryGalleryScene) {
   // Each method on a third of the scenes keeps the run short; the conformance tests render
   // every scene with every method through the same backend.
   const fs::path dir = test::make_temp_dir();
   const std::string methods[] = {"sphere", "relaxed", "analytic"};
-  const std::vector<std::string> scenes = gallery();
+  std::vector<std::string> scenes;
+  for (const auto& file : test::gallery_files()) scenes.push_back(file.string());
   for (size_t k = 0; k < scenes.size(); ++k) {
     const std::string& scene = scenes[k];
     const std::string& method = methods[k % 3];

@@ -10,6 +10,7 @@
 
 #include "backends/oracle/oracle.hpp"
 #include "scene/load.hpp"
+#include "tests/gallery.hpp"
 
 namespace flatmarch {
 namespace {
@@ -62,17 +63,9 @@ const std::map<std::string, Surface>& expected() {
   return table;
 }
 
-std::vector<fs::path> gallery() {
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(FLATMARCH_SOURCE_DIR "/scenes"))
-    if (entry.path().extension() == ".json") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 TEST(Gallery, HasEverySurfaceOfThePaperAndTheApp) {
   std::set<std::string> stems;
-  for (const fs::path& f : gallery()) stems.insert(f.stem().string());
+  for (const fs::path& f : test::gallery_files()) stems.insert(f.stem().string());
   for (const auto& [name, surface] : expected())
     EXPECT_TRUE(stems.count(name)) << name << " is missing";
 }
@@ -110,7 +103,7 @@ TEST_P(GalleryScene, CameraShowsAnObjectAndMore) {
   EXPECT_GE(*codes.rbegin(), 0.0f) << "no object in sight";
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, GalleryScene, testing::ValuesIn(gallery()),
+INSTANTIATE_TEST_SUITE_P(Scenes, GalleryScene, testing::ValuesIn(test::gallery_files()),
                          [](const testing::TestParamInfo<fs::path>& p) {
                            return p.param.stem().string();
                          });

@@ -14,6 +14,7 @@
 #include "backends/scalar/scalar.hpp"
 #include "kernels/camera.hpp"
 #include "scene/load.hpp"
+#include "tests/gallery.hpp"
 #include "tests/process.hpp"
 
 namespace flatmarch {
@@ -23,25 +24,6 @@ namespace fs = std::filesystem;
 
 constexpr int kEvents = 20;
 constexpr int kRaysPerScene = 8;
-
-std::vector<std::string> gallery() {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(fs::path(FLATMARCH_SOURCE_DIR) / "scenes"))
-    if (entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
-const Scene& scene_named(const std::string& name) {
-  static std::map<std::string, Scene> cache;
-  auto it = cache.find(name);
-  if (it == cache.end())
-    it =
-        cache
-            .emplace(name, load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "scenes" / (name + ".json")))
-            .first;
-  return it->second;
-}
 
 // Whether the oracle's path, up to its kEvents-th event, keeps `margin` away from every vertex
 // and crosses every edge at a sine of at least `min_sine`: a generic ray, whose fate rounding
@@ -131,7 +113,7 @@ struct Case {
 class ScalarConformance : public testing::TestWithParam<Case> {};
 
 TEST_P(ScalarConformance, GenericRaysFollowTheOraclesEdgeSequence) {
-  const Scene& scene = scene_named(GetParam().scene);
+  const Scene& scene = test::gallery_scene(GetParam().scene);
   const std::vector<Ray> rays = generic_rays(scene);
   ASSERT_EQ(static_cast<int>(rays.size()), kRaysPerScene) << "too few generic rays found";
   MarchParams params;
@@ -173,7 +155,7 @@ std::vector<std::set<int>> oracle_answers(const Scene& scene, int width, int hei
 }
 
 TEST_P(ScalarConformance, HitAovAgreesWithTheOracle) {
-  const Scene& scene = scene_named(GetParam().scene);
+  const Scene& scene = test::gallery_scene(GetParam().scene);
   MarchParams params;
   params.method = GetParam().method;
   const Frame truth = OracleBackend().render(scene, scene.camera, 160, 90, {}, {});
@@ -224,7 +206,7 @@ double mean_steps(const Scene& scene, Method method) {
 TEST(ScalarSteps, AnalyticTakesTenTimesFewerStepsThanSphereOnTranslationSurfaces) {
   // Steps are deterministic, so this holds on any machine (bench/kernel_bench reports them too).
   for (const std::string name : {"l_shape", "double_pentagon"}) {
-    const Scene& scene = scene_named(name);
+    const Scene& scene = test::gallery_scene(name);
     const double sphere = mean_steps(scene, Method::sphere);
     const double analytic = mean_steps(scene, Method::analytic);
     std::cout << name << ": mean steps per ray at 320x180, sphere " << sphere << ", analytic "
@@ -235,7 +217,7 @@ TEST(ScalarSteps, AnalyticTakesTenTimesFewerStepsThanSphereOnTranslationSurfaces
 
 std::vector<Case> cases() {
   std::vector<Case> all;
-  for (const std::string& name : gallery())
+  for (const std::string& name : test::gallery_names())
     for (Method m : {Method::sphere, Method::relaxed, Method::analytic}) all.push_back({name, m});
   return all;
 }

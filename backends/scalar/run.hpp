@@ -4,6 +4,7 @@
 #pragma once
 
 #include "backends/backend.hpp"
+#include "backends/kernel_trace.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/compile.hpp"
 
@@ -37,22 +38,13 @@ Trace trace_in(const Scene& scene, const Ray& ray, const MarchParams& params, in
   using vec3 = glm::vec<3, real>;
   const kernel::SceneTables<real> tables = kernel::compile_scene<real>(scene, params);
   std::vector<kernel::KernelEvent> events;
-  Trace trace;
+  int steps = 0;
   kernel::with_kernel<real>(tables, [&](auto& k) {
     k.events = &events;
     k.max_events = max_events;
-    trace.steps = k.march(ray.polygon, vec3(ray.from), vec3(ray.dir)).steps;
+    steps = k.march(ray.polygon, vec3(ray.from), vec3(ray.dir)).steps;
   });
-  for (const kernel::KernelEvent& e : events)
-    trace.events.push_back({.kind = static_cast<EventKind>(e.kind),
-                            .polygon = e.polygon,
-                            .edge = e.edge,
-                            .to_polygon = e.to_polygon,
-                            .to_edge = e.to_edge,
-                            .object = e.object,
-                            .t = e.t,
-                            .at = e.at});
-  return trace;
+  return kernel_trace(events, steps);
 }
 
 // Compiled in scalar_f32.cpp and scalar_f64.cpp only.

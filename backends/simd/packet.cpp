@@ -1,0 +1,790 @@
+// The kernel of kernels/march.glsl run on packets of rays with Google Highway: one ray per lane,
+// a packet covering a small tile of pixels (packet.hpp's tile_shape), its march state in vectors.
+// The functions mirror march.glsl's one for one, with the same names, operations and order of
+// floating-point operations (and no fused multiply-add: this file is compiled with
+// -ffp-contract=off), so that a lane takes exactly the steps the scalar backend takes.
+//
+// What differs is control flow. Where the kernel branches, a packet computes under masks and
+// blends. The tables are read per polygon, not per lane: each step runs in passes, one per
+// polygon among the packet's unfinished rays, and in a pass every table read is one record
+// broadcast to all lanes (a coherent tile's rays are mostly in the same room, so this usually
+// means one pass a step; no gathers). Finished lanes are masked off; the share of lanes doing
+// work in a pass is the lane utilisation the benchmark reports.
+//
+// This file is compiled once per instruction set (hwy/foreach_target.h) and the best one the CPU
+// supports is picked at run time (HWY_DYNAMIC_DISPATCH; simd.cpp can force one).
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "backends/simd/packet.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include <algorithm>
+#include <array>
+#include <mutex>
+
+#include "backends/simd/packet.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace flatmarch::simd {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using kernel::ivec4;
+using D = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<D>;
+using V = hn::Vec<D>;
+using VI = hn::Vec<DI>;
+using M = hn::Mask<D>;
+using EdgeRecord = kernel::Tables<float>::EdgeRecord;
+using ObjectRecord = kernel::Tables<float>::ObjectRecord;
+using KernelParams = kernel::Tables<float>::KernelParams;
+
+HWY_INLINE V Splat(float x) {
+  return hn::Set(D(), x);
+}
+HWY_INLINE VI SplatI(int x) {
+  return hn::Set(DI(), x);
+}
+HWY_INLINE M None() {
+  return hn::FirstN(D(), 0);
+}
+HWY_INLINE M Equal(VI a, int b) {
+  return hn::RebindMask(D(), a == SplatI(b));
+}
+HWY_INLINE M AtLeastZero(VI a) {
+  return hn::RebindMask(D(), a > SplatI(-1));
+}
+// m ? a : b, lane by lane.
+HWY_INLINE V Select(M m, V a, V b) {
+  return hn::IfThenElse(m, a, b);
+}
+HWY_INLINE VI Select(M m, VI a, VI b) {
+  return hn::IfThenElse(hn::RebindMask(DI(), m), a, b);
+}
+HWY_INLINE M Select(M m, M a, M b) {
+  return hn::Or(hn::And(m, a), hn::AndNot(m, b));
+}
+HWY_INLINE bool Any(M m) {
+  return !hn::AllFalse(D(), m);
+}
+
+// What a packet of rays is doing (march.glsl's Ray, one lane per ray).
+struct Packet {
+  VI polygon;
+  V ox, oy, oz;  // point, in the coordinates of `polygon`
+  V dx, dy, dz;  // unit direction
+  V t;
+  VI steps, crossings, hit;
+  M done;
+  V nx, ny, nz;  // normal of the solid hit
+  V sr, sg, sb;  // colour of the solid hit
+};
+
+struct WallDistance {
+  V d;
+  VI edge;
+  V second;
+};
+
+struct Exit {
+  V s;
+  VI edge;
+  M corner;
+};
+
+struct SolidDistance {
+  V d;
+  VI object;
+};
+
+struct Relaxation {
+  V omega, last_radius, last_step;
+};
+
+struct Segment {
+  M known;
+  Exit exit;
+  V solids;
+};
+
+class Marcher {
+ public:
+  Marcher(const kernel::SceneTables<float>& tables, std::vector<kernel::KernelEvent>* events,
+          int max_events)
+      : polygons_(tables.polygons.data()),
+        edges_(tables.edges.data()),
+        objects_(tables.objects.data()),
+        params_(tables.params),
+        features_(tables.features),
+        events_(events),
+        max_events_(max_events) {}
+
+  // march.glsl's march() for the lanes not `done` from the start; their steps are counted in
+  // `lanes`.
+  void march(Packet& r, int polygon, V fx, V fy, V fz, V dx, V dy, V dz, LaneCounts& lanes) const {
+    r.polygon = SplatI(polygon);
+    r.ox = fx;
+    r.oy = fy;
+    r.oz = fz;
+    const V inv = Splat(1.0f) / hn::Sqrt(dx * dx + dy * dy + dz * dz);  // normalize
+    r.dx = dx * inv;
+    r.dy = dy * inv;
+    r.dz = dz * inv;
+    r.t = Splat(0.0f);
+    r.steps = SplatI(0);
+    r.crossings = SplatI(0);
+    r.hit = SplatI(kHitMaxSteps);
+    r.nx = r.ny = r.nz = Splat(0.0f);
+    r.sr = r.sg = r.sb = Splat(0.0f);
+    const M live = hn::Not(r.done);
+    if (has(kFeaturePeriod)) {
+      const V top = Splat(params_.top);
+      r.oz = Select(live, r.oz - top * hn::Floor(r.oz / top), r.oz);  // mod
+    } else {
+      const M outside = hn::Or(r.oz<Splat(0.0f), r.oz> Splat(params_.height));
+      enter_band(r, hn::And(live, outside));
+    }
+    Relaxation x;
+    x.omega = Splat(params_.method == kMethodRelaxed ? params_.omega : 1.0f);  // relax
+    x.last_radius = x.last_step = Splat(0.0f);
+    Segment seg;
+    seg.known = None();
+    seg.exit.s = Splat(kFar);
+    seg.exit.edge = SplatI(-1);
+    seg.exit.corner = None();
+    seg.solids = Splat(kFar);
+    const size_t n = hn::Lanes(D());
+    std::array<int32_t, hn::MaxLanes(DI())> rooms{};
+    for (int i = 0; i < params_.max_steps; ++i) {
+      const M active = hn::Not(r.done);
+      if (!Any(active)) break;
+      r.steps = Select(active, r.steps + SplatI(1), r.steps);
+      // One pass per polygon among the active lanes; the rays a pass moves to another room are
+      // already out of `pending`.
+      hn::StoreU(r.polygon, DI(), rooms.data());
+      M pending = active;
+      while (Any(pending)) {
+        const int room = rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
+        const M pass = hn::And(pending, Equal(r.polygon, room));
+        lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
+        lanes.slots += static_cast<int64_t>(n);
+        if (params_.method == kMethodAnalytic)
+          analytic_step(r, seg, pass, room);
+        else
+          sphere_step(r, x, pass, room);
+        pending = hn::AndNot(pass, pending);
+      }
+    }
+    const M unfinished = hn::Not(r.done);
+    if (Any(unfinished))
+      finish(r, unfinished, SplatI(kHitMaxSteps), kEventMaxSteps, SplatI(-1), Splat(0.0f));
+  }
+
+  // march.glsl's shade(): the linear colour of finished rays. transmittance[c] is
+  // (1 - wall_tint)^c as shade computes it, for the first crossing counts.
+  void shade(const Packet& r, const std::vector<float>& transmittance, V& red, V& green,
+             V& blue) const {
+    V cr = Splat(params_.background.x), cg = Splat(params_.background.y);
+    V cb = Splat(params_.background.z);
+    const M object = AtLeastZero(r.hit);
+    cr = Select(object, r.sr, cr);
+    cg = Select(object, r.sg, cg);
+    cb = Select(object, r.sb, cb);
+    const M wall = Equal(r.hit, kHitWall);
+    const V grey = Splat(kWallGrey);
+    cr = Select(wall, grey, cr);
+    cg = Select(wall, grey, cg);
+    cb = Select(wall, grey, cb);
+    const M floor = Equal(r.hit, kHitFloor);
+    if (Any(floor)) {
+      const V check = hn::Floor(r.ox / Splat(kFloorCheck)) + hn::Floor(r.oy / Splat(kFloorCheck));
+      const V two = Splat(2.0f);
+      const V parity = check - two * hn::Floor(check / two);  // mod
+      const V tone = Select(parity >= Splat(1.0f), Splat(kFloorDarkGrey), grey);
+      cr = Select(floor, tone, cr);
+      cg = Select(floor, tone, cg);
+      cb = Select(floor, tone, cb);
+    }
+    const M black = hn::Or(Equal(r.hit, kHitMaxSteps), Equal(r.hit, kHitVertex));
+    cr = hn::IfThenZeroElse(black, cr);
+    cg = hn::IfThenZeroElse(black, cg);
+    cb = hn::IfThenZeroElse(black, cb);
+    const int last = static_cast<int>(transmittance.size()) - 1;
+    V tr = hn::GatherIndex(D(), transmittance.data(), hn::Min(r.crossings, SplatI(last)));
+    if (!hn::AllFalse(DI(), r.crossings > SplatI(last))) {  // beyond the table
+      std::array<int32_t, hn::MaxLanes(DI())> crossings{};
+      std::array<float, hn::MaxLanes(D())> factor{};
+      hn::StoreU(r.crossings, DI(), crossings.data());
+      hn::StoreU(tr, D(), factor.data());
+      for (size_t l = 0; l < hn::Lanes(D()); ++l)
+        if (crossings[l] > last)
+          factor[l] = glm::pow(1.0f - params_.wall_tint, static_cast<float>(crossings[l]));
+      tr = hn::LoadU(D(), factor.data());
+    }
+    const V fog = Splat(1.0f) - tr;
+    red = tr * cr + fog * Splat(params_.fog.x);
+    green = tr * cg + fog * Splat(params_.fog.y);
+    blue = tr * cb + fog * Splat(params_.fog.z);
+  }
+
+ private:
+  bool has(uint feature) const { return (features_ & feature) != 0u; }
+
+  // Records an event of lane 0 (the one a trace follows) when it is in `m`.
+  void record(M m, int kind, VI polygon, VI edge, int to_polygon, int to_edge, VI hit,
+              const Packet& r) const {
+    if (!events_ || static_cast<int>(events_->size()) >= max_events_ ||
+        hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1))))
+      return;
+    const int h = hn::GetLane(hit);
+    events_->push_back({kind, hn::GetLane(polygon), hn::GetLane(edge), to_polygon, to_edge,
+                        h >= 0 ? h : -1, static_cast<double>(hn::GetLane(r.t)),
+                        glm::dvec3(hn::GetLane(r.ox), hn::GetLane(r.oy), hn::GetLane(r.oz))});
+  }
+
+  static void advance(Packet& r, M m, V s) {
+    r.ox = Select(m, r.ox + s * r.dx, r.ox);
+    r.oy = Select(m, r.oy + s * r.dy, r.oy);
+    r.oz = Select(m, r.oz + s * r.dz, r.oz);
+    r.t = Select(m, r.t + s, r.t);
+  }
+
+  // Ends the rays of `m` `s` further on.
+  void finish(Packet& r, M m, VI hit, int event, VI edge, V s) const {
+    advance(r, m, s);
+    r.hit = Select(m, hit, r.hit);
+    r.done = hn::Or(r.done, m);
+    record(m, event, r.polygon, edge, -1, -1, hit, r);
+  }
+
+  // ---- Walls ---------------------------------------------------------------------------------
+
+  // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a.
+  static M crosses(float ay, float abx, float aby, V py, V apx, V apy) {
+    const M over_a = py >= Splat(ay);
+    const M under_b = py < Splat(ay + aby);
+    const M left = Splat(abx) * apy > Splat(aby) * apx;
+    return hn::Or(hn::And(hn::And(over_a, under_b), left),
+                  hn::Not(hn::Or(hn::Or(over_a, under_b), left)));
+  }
+
+  M inside_polygon(int polygon, V px, V py) const {
+    const ivec4 poly = polygons_[polygon];
+    M inside = None();
+    for (int k = poly.x; k < poly.x + poly.y; ++k) {
+      const glm::vec4 s = edges_[k].segment;
+      const V apx = px - Splat(s.x), apy = py - Splat(s.y);
+      inside = hn::Xor(inside, crosses(s.y, s.z - s.x, s.w - s.y, py, apx, apy));
+    }
+    return inside;
+  }
+
+  WallDistance wall_distance(int polygon, V px, V py) const {
+    const ivec4 poly = polygons_[polygon];
+    V best = Splat(kFar), second = Splat(kFar);
+    VI edge = SplatI(-1);
+    M inside = None();
+    for (int k = 0; k < poly.y; ++k) {
+      const EdgeRecord& e = edges_[poly.x + k];
+      const float abx = e.segment.z - e.segment.x, aby = e.segment.w - e.segment.y;
+      const V apx = px - Splat(e.segment.x), apy = py - Splat(e.segment.y);
+      const V h =
+          hn::Min(hn::Max((apx * Splat(abx) + apy * Splat(aby)) * Splat(e.line.w), Splat(0.0f)),
+                  Splat(1.0f));
+      const V qx = apx - h * Splat(abx), qy = apy - h * Splat(aby);
+      const V d2 = qx * qx + qy * qy;
+      const M nearest = d2 < best;
+      second = Select(nearest, best, Select(d2 < second, d2, second));
+      best = Select(nearest, d2, best);
+      edge = Select(nearest, SplatI(k), edge);
+      inside = hn::Xor(inside, crosses(e.segment.y, abx, aby, py, apx, apy));
+    }
+    WallDistance w;
+    const V root = hn::Sqrt(best);
+    w.d = Select(inside, root, hn::Neg(root));
+    w.edge = edge;
+    w.second = hn::Sqrt(second);
+    return w;
+  }
+
+  Exit exit_edge(int polygon, V ox, V oy, V dhx, V dhy) const {
+    const ivec4 poly = polygons_[polygon];
+    Exit x;
+    x.s = Splat(kFar);
+    x.edge = SplatI(-1);
+    x.corner = None();
+    const V vertex_tolerance = Splat(params_.vertex_tolerance);
+    for (int k = 0; k < poly.y; ++k) {
+      const EdgeRecord& e = edges_[poly.x + k];
+      const V nx = Splat(e.line.x), ny = Splat(e.line.y);
+      const V dn = dhx * nx + dhy * ny;
+      const V s = (Splat(e.line.z) - (ox * nx + oy * ny)) / dn;
+      M ok = hn::And(dn > Splat(0.0f), hn::Not(hn::Or(s < hn::Neg(vertex_tolerance), s >= x.s)));
+      const float ax = e.segment.x, ay = e.segment.y;
+      const V u = (((ox + s * dhx) - Splat(ax)) * Splat(e.segment.z - ax) +
+                   ((oy + s * dhy) - Splat(ay)) * Splat(e.segment.w - ay)) *
+                  Splat(e.line.w);
+      const float tolerance = params_.vertex_tolerance * std::sqrt(e.line.w);
+      ok = hn::AndNot(hn::Or(u<Splat(-tolerance), u> Splat(1.0f + tolerance)), ok);
+      x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
+      x.edge = Select(ok, SplatI(k), x.edge);
+      x.corner = Select(ok, hn::Or(u <= Splat(tolerance), u >= Splat(1.0f - tolerance)), x.corner);
+    }
+    return x;
+  }
+
+  V band_exit(V oz, V dz) const {
+    const V up = (Splat(params_.top) - oz) / dz;
+    const V down = hn::Neg(oz) / dz;
+    return Select(dz > Splat(0.0f), up, Select(dz < Splat(0.0f), down, Splat(kFar)));
+  }
+
+  // Moves p along the normal of an edge's line so that it lies `inside` within it.
+  static void place(V& px, V& py, const glm::vec4& line, V inside) {
+    const V nx = Splat(line.x), ny = Splat(line.y);
+    const V k = ((px * nx + py * ny) - Splat(line.z)) + inside;
+    px = px - k * nx;
+    py = py - k * ny;
+  }
+
+  // The rays of `m` (in `polygon`) at their edge `edge` go through it or are reflected, and are
+  // placed `push` inside the edge they are then behind. One broadcast record per edge.
+  void cross_edge(Packet& r, M m, int polygon, VI edge, V push) const {
+    const ivec4 poly = polygons_[polygon];
+    for (int k = 0; k < poly.y; ++k) {
+      const M mk = hn::And(m, Equal(edge, k));
+      if (!Any(mk)) continue;
+      const EdgeRecord& e = edges_[poly.x + k];
+      V px = r.ox, py = r.oy;
+      V hx = r.dx, hy = r.dy, hz = r.dz;
+      if (has(kFeatureMirrors) && e.link.x == kEdgeMirror) {
+        record(mk, kEventMirror, r.polygon, SplatI(k), -1, -1, SplatI(-1), r);
+        const V nx = Splat(e.line.x), ny = Splat(e.line.y);
+        place(px, py, e.line, push);
+        const V twice = Splat(2.0f) * (hx * nx + hy * ny);
+        hx = hx - twice * nx;
+        hy = hy - twice * ny;
+      } else {
+        const ivec4 link = e.link;
+        record(mk, kEventGluing, r.polygon, SplatI(k), link.y, link.z, SplatI(-1), r);
+        const glm::vec4 a = e.map_linear;
+        const V mx = Splat(a.x), my = Splat(a.y), mz = Splat(a.z), mw = Splat(a.w);
+        px = (mx * r.ox + mz * r.oy) + Splat(e.map_shift.x);
+        py = (my * r.ox + mw * r.oy) + Splat(e.map_shift.y);
+        hx = mx * r.dx + mz * r.dy;
+        hy = my * r.dx + mw * r.dy;
+        place(px, py, edges_[polygons_[link.y].x + link.z].line, push);
+        if (has(kFeatureScaled)) {  // normalize
+          const V inv = Splat(1.0f) / hn::Sqrt(hx * hx + hy * hy + hz * hz);
+          hx = hx * inv;
+          hy = hy * inv;
+          hz = hz * inv;
+        }
+        r.polygon = Select(mk, SplatI(link.y), r.polygon);
+      }
+      r.ox = Select(mk, px, r.ox);
+      r.oy = Select(mk, py, r.oy);
+      r.dx = Select(mk, hx, r.dx);
+      r.dy = Select(mk, hy, r.dy);
+      r.dz = Select(mk, hz, r.dz);
+    }
+    r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
+  }
+
+  // Which lanes' `edge` of `polygon` is an opaque wall.
+  M is_wall(int polygon, VI edge) const {
+    M wall = None();
+    if (!has(kFeatureWalls)) return wall;
+    const ivec4 poly = polygons_[polygon];
+    for (int k = 0; k < poly.y; ++k)
+      if (edges_[poly.x + k].link.x == kEdgeWall) wall = hn::Or(wall, Equal(edge, k));
+    return wall;
+  }
+
+  // The rays of `m` reach the top or bottom of the band, `s` further on.
+  void leave_band(Packet& r, M m, V s) const {
+    if (has(kFeaturePeriod)) {
+      advance(r, m, s);
+      r.oz = Select(m, Select(r.dz > Splat(0.0f), Splat(0.0f), Splat(params_.top)), r.oz);
+    } else if (has(kFeatureFloor)) {
+      const M down = hn::And(m, r.dz < Splat(0.0f));
+      finish(r, down, SplatI(kHitFloor), kEventFloor, SplatI(-1), s);
+      r.nz = Select(down, Splat(1.0f), r.nz);
+      finish(r, hn::AndNot(down, m), SplatI(kHitEscape), kEventEscape, SplatI(-1), s);
+    } else {
+      finish(r, m, SplatI(kHitEscape), kEventEscape, SplatI(-1), s);
+    }
+  }
+
+  // ---- Solids --------------------------------------------------------------------------------
+
+  V solid_distance(int k, V px, V py, V pz) const {
+    const ObjectRecord& o = objects_[k];
+    const V qx = px - Splat(o.center.x), qy = py - Splat(o.center.y);
+    const V qz = pz - Splat(o.center.z);
+    const int solid = o.info.x;
+    if (solid == kSolidSphere) return hn::Sqrt(qx * qx + qy * qy + qz * qz) - Splat(o.shape.x);
+    const V zero = Splat(0.0f);
+    if (solid == kSolidCylinder) {
+      const V wx = hn::Sqrt(qx * qx + qy * qy) - Splat(o.shape.x);
+      const V wy = hn::Abs(qz) - Splat(o.shape.y);
+      const V mx = hn::Max(wx, zero), my = hn::Max(wy, zero);
+      return hn::Min(hn::Max(wx, wy), zero) + hn::Sqrt(mx * mx + my * my);
+    }
+    const V wx = hn::Abs(qx) - Splat(o.shape.x), wy = hn::Abs(qy) - Splat(o.shape.y);
+    const V wz = hn::Abs(qz) - Splat(o.shape.z);
+    const V mx = hn::Max(wx, zero), my = hn::Max(wy, zero), mz = hn::Max(wz, zero);
+    const V box =
+        hn::Sqrt(mx * mx + my * my + mz * mz) + hn::Min(hn::Max(wx, hn::Max(wy, wz)), zero);
+    if (solid == kSolidBox) return box;
+    return hn::Max(box, Splat(o.shape.w) - hn::Sqrt(qx * qx + qy * qy + qz * qz));
+  }
+
+  SolidDistance nearest_solid(int polygon, V px, V py, V pz) const {
+    SolidDistance best;
+    best.d = Splat(kFar);
+    best.object = SplatI(-1);
+    if (!has(kFeatureObjects)) return best;
+    const ivec4 poly = polygons_[polygon];
+    for (int k = poly.z; k < poly.z + poly.w; ++k) {
+      const V dk = solid_distance(k, px, py, pz);
+      const M nearer = dk < best.d;
+      best.d = Select(nearer, dk, best.d);
+      best.object = Select(nearer, SplatI(k), best.object);
+    }
+    return best;
+  }
+
+  // Where a ray first comes within eps of a solid's bounding sphere in its room, or kFar.
+  V solid_entry(int polygon, const Packet& r) const {
+    const ivec4 poly = polygons_[polygon];
+    V first = Splat(kFar);
+    M inside = None();
+    for (int k = poly.z; k < poly.z + poly.w; ++k) {
+      const glm::vec4 c = objects_[k].center;
+      const V ocx = r.ox - Splat(c.x), ocy = r.oy - Splat(c.y), ocz = r.oz - Splat(c.z);
+      const float radius = c.w + params_.eps;
+      const V b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
+      const V cc = (ocx * ocx + ocy * ocy + ocz * ocz) - Splat(radius * radius);
+      inside = hn::Or(inside, cc <= Splat(0.0f));
+      const V disc = b * b - cc;
+      const M ahead = hn::And(b < Splat(0.0f), disc >= Splat(0.0f));
+      first = Select(ahead, hn::Min(first, hn::Neg(b) - hn::Sqrt(disc)), first);
+    }
+    return hn::IfThenZeroElse(inside, first);
+  }
+
+  // The gradient of solid k's distance at p by central differences on a tetrahedron.
+  void solid_normal(int k, V px, V py, V pz, V& nx, V& ny, V& nz) const {
+    const V h = Splat(params_.normal_step);
+    const V s1 = solid_distance(k, px + h, py - h, pz - h);  // (1, -1, -1)
+    const V s2 = solid_distance(k, px - h, py - h, pz + h);  // (-1, -1, 1)
+    const V s3 = solid_distance(k, px - h, py + h, pz - h);  // (-1, 1, -1)
+    const V s4 = solid_distance(k, px + h, py + h, pz + h);  // (1, 1, 1)
+    const V gx = ((s1 - s2) - s3) + s4;
+    const V gy = ((hn::Neg(s1) - s2) + s3) + s4;
+    const V gz = ((hn::Neg(s1) + s2) - s3) + s4;
+    const V inv = Splat(1.0f) / hn::Sqrt(gx * gx + gy * gy + gz * gz);
+    nx = gx * inv;
+    ny = gy * inv;
+    nz = gz * inv;
+  }
+
+  // The rays of `m` hit their `object` of `polygon` where they are.
+  void hit_solid(Packet& r, M m, int polygon, VI object) const {
+    const ivec4 poly = polygons_[polygon];
+    for (int k = poly.z; k < poly.z + poly.w; ++k) {
+      const M mk = hn::And(m, Equal(object, k));
+      if (!Any(mk)) continue;
+      V nx, ny, nz;
+      solid_normal(k, r.ox, r.oy, r.oz, nx, ny, nz);
+      r.nx = Select(mk, nx, r.nx);
+      r.ny = Select(mk, ny, r.ny);
+      r.nz = Select(mk, nz, r.nz);
+      const glm::vec4 c = objects_[k].color;
+      const V half = Splat(0.5f);
+      r.sr = Select(mk, c.w > 0.0f ? Splat(c.x) : half + half * nx, r.sr);
+      r.sg = Select(mk, c.w > 0.0f ? Splat(c.y) : half + half * ny, r.sg);
+      r.sb = Select(mk, c.w > 0.0f ? Splat(c.z) : half + half * nz, r.sb);
+      finish(r, mk, SplatI(objects_[k].info.y), kEventObject, SplatI(-1), Splat(0.0f));
+    }
+  }
+
+  // ---- Methods -------------------------------------------------------------------------------
+
+  void relax(Relaxation& x, M m) const {
+    const V omega = Splat(params_.method == kMethodRelaxed ? params_.omega : 1.0f);
+    x.omega = Select(m, omega, x.omega);
+    x.last_radius = hn::IfThenZeroElse(m, x.last_radius);
+    x.last_step = hn::IfThenZeroElse(m, x.last_step);
+  }
+
+  // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `polygon`.
+  void sphere_step(Packet& r, Relaxation& x, M m, int polygon) const {
+    const WallDistance wall = wall_distance(polygon, r.ox, r.oy);
+    const SolidDistance solid = nearest_solid(polygon, r.ox, r.oy, r.oz);
+    const V radius = hn::Min(wall.d, solid.d);
+    // Over-relaxed steps whose unbounding spheres do not overlap are taken back.
+    const M back = hn::And(hn::And(m, x.omega > Splat(1.0f)), radius + x.last_radius < x.last_step);
+    M rest = hn::AndNot(back, m);
+    if (Any(back)) {
+      advance(r, back, x.last_radius - x.last_step);
+      x.last_step = Select(back, x.last_radius, x.last_step);
+      x.omega = Select(back, Splat(1.0f), x.omega);
+    }
+    const V wall_d = hn::Abs(wall.d);
+    const V eps = Splat(params_.eps);
+    const M hit = hn::And(rest, hn::And(solid.d < eps, solid.d <= wall_d));
+    if (Any(hit)) {
+      hit_solid(r, hit, polygon, solid.object);
+      rest = hn::AndNot(hit, rest);
+    }
+    const M near = hn::And(rest, wall_d < eps);
+    if (Any(near)) {
+      const M corner = hn::And(near, wall.second < eps);
+      finish(r, corner, SplatI(kHitVertex), kEventVertex, SplatI(-1), Splat(0.0f));
+      const M walls = hn::AndNot(corner, hn::And(near, is_wall(polygon, wall.edge)));
+      finish(r, walls, SplatI(kHitWall), kEventWall, wall.edge, Splat(0.0f));
+      const M cross = hn::AndNot(hn::Or(corner, walls), near);
+      if (Any(cross)) {
+        cross_edge(r, cross, polygon, wall.edge, Splat(params_.offset));
+        relax(x, cross);
+      }
+      rest = hn::AndNot(near, rest);
+    }
+    const V safe = hn::Abs(radius);
+    const V band = band_exit(r.oz, r.dz);
+    const V remaining = Splat(params_.max_distance) - r.t;
+    const M far = hn::And(rest, remaining <= hn::Min(safe, band));
+    finish(r, far, SplatI(kHitMaxDistance), kEventMaxDistance, SplatI(-1), remaining);
+    rest = hn::AndNot(far, rest);
+    const M leave = hn::And(rest, band <= safe);
+    if (Any(leave)) {
+      leave_band(r, leave, band);
+      relax(x, leave);
+      rest = hn::AndNot(leave, rest);
+    }
+    x.last_radius = Select(rest, safe, x.last_radius);
+    x.last_step = Select(rest, hn::Min(x.omega * safe, hn::Min(band, remaining)), x.last_step);
+    advance(r, rest, x.last_step);
+  }
+
+  static void move_in_segment(Packet& r, Segment& seg, M m, V s) {
+    advance(r, m, s);
+    seg.exit.s = Select(m, seg.exit.s - s, seg.exit.s);
+    seg.solids = Select(m, hn::Max(seg.solids - s, Splat(0.0f)), seg.solids);
+  }
+
+  // One iteration of the analytic method for the rays of `m`, in `polygon`.
+  void analytic_step(Packet& r, Segment& seg, M m, int polygon) const {
+    const M unknown = hn::AndNot(seg.known, m);
+    if (Any(unknown)) {
+      const Exit x = exit_edge(polygon, r.ox, r.oy, r.dx, r.dy);
+      seg.exit.s = Select(unknown, x.s, seg.exit.s);
+      seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
+      seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
+      if (has(kFeatureObjects))
+        seg.solids = Select(unknown, solid_entry(polygon, r), seg.solids);
+      else
+        seg.solids = Select(unknown, Splat(kFar), seg.solids);
+      seg.known = hn::Or(seg.known, unknown);
+    }
+    const V max_distance = Splat(params_.max_distance);
+    V remaining = max_distance - r.t;
+    M rest = m;
+    if (has(kFeatureObjects)) {
+      const M solids =
+          hn::And(m, seg.solids < hn::Min(hn::Min(seg.exit.s, band_exit(r.oz, r.dz)), remaining));
+      if (Any(solids)) {
+        move_in_segment(r, seg, solids, seg.solids);
+        const SolidDistance solid = nearest_solid(polygon, r.ox, r.oy, r.oz);
+        const M hit = hn::And(solids, solid.d < Splat(params_.eps));
+        hit_solid(r, hit, polygon, solid.object);
+        const M on = hn::AndNot(hit, solids);
+        remaining = Select(on, max_distance - r.t, remaining);
+        const M step =
+            hn::And(on, solid.d < hn::Min(hn::Min(seg.exit.s, band_exit(r.oz, r.dz)), remaining));
+        move_in_segment(r, seg, step, solid.d);
+        rest = hn::AndNot(hn::Or(hit, step), rest);
+      }
+    }
+    const V band = band_exit(r.oz, r.dz);
+    const M far = hn::And(rest, remaining < hn::Min(seg.exit.s, band));
+    finish(r, far, SplatI(kHitMaxDistance), kEventMaxDistance, SplatI(-1), remaining);
+    rest = hn::AndNot(far, rest);
+    const M leave = hn::And(rest, band <= seg.exit.s);
+    if (Any(leave)) {
+      leave_band(r, leave, band);
+      seg.known = hn::AndNot(leave, seg.known);
+      rest = hn::AndNot(leave, rest);
+    }
+    const M no_edge = hn::RebindMask(D(), seg.exit.edge < SplatI(0));
+    const M vertex = hn::And(rest, hn::Or(no_edge, seg.exit.corner));
+    finish(r, vertex, SplatI(kHitVertex), kEventVertex, SplatI(-1),
+           hn::IfThenZeroElse(no_edge, seg.exit.s));
+    rest = hn::AndNot(vertex, rest);
+    const M wall = hn::And(rest, is_wall(polygon, seg.exit.edge));
+    finish(r, wall, SplatI(kHitWall), kEventWall, seg.exit.edge, seg.exit.s);
+    rest = hn::AndNot(wall, rest);
+    if (Any(rest)) {
+      advance(r, rest, seg.exit.s);
+      cross_edge(r, rest, polygon, seg.exit.edge, Splat(0.0f));
+      seg.known = hn::AndNot(rest, seg.known);
+    }
+  }
+
+  // ---- A whole ray ---------------------------------------------------------------------------
+
+  // The rays of `m`, outside the band, enter the first polygon whose footprint they cross.
+  void enter_band(Packet& r, M m) const {
+    if (!Any(m)) return;
+    const V height = Splat(params_.height), max_distance = Splat(params_.max_distance);
+    const M above = r.oz > height;
+    const M toward = Select(above, r.dz<Splat(0.0f), r.dz> Splat(0.0f));
+    V s = Select(toward, (hn::IfThenElseZero(above, height) - r.oz) / r.dz, max_distance);
+    s = Select(s > max_distance, max_distance, s);
+    const V qx = r.ox + s * r.dx, qy = r.oy + s * r.dy;
+    M open = hn::And(m, s < max_distance);
+    for (int k = 0; k < params_.polygon_count && Any(open); ++k) {
+      const M in = hn::And(open, inside_polygon(k, qx, qy));
+      if (!Any(in)) continue;
+      r.polygon = Select(in, SplatI(k), r.polygon);
+      M enter = in;
+      if (has(kFeatureFloor)) {  // the underside of the floor
+        const M under = hn::AndNot(above, in);
+        finish(r, under, SplatI(kHitFloor), kEventFloor, SplatI(-1), s);
+        r.nz = Select(under, Splat(-1.0f), r.nz);
+        enter = hn::AndNot(under, in);
+      }
+      advance(r, enter, s);
+      record(enter, kEventEnter, SplatI(k), SplatI(-1), -1, -1, SplatI(-1), r);
+      open = hn::AndNot(in, open);
+      m = hn::AndNot(in, m);
+    }
+    if (!Any(m)) return;
+    advance(r, m, s);
+    r.hit = Select(m, SplatI(kHitMiss), r.hit);
+    r.done = hn::Or(r.done, m);
+    record(m, kEventMiss, SplatI(-1), SplatI(-1), -1, -1, SplatI(-1), r);
+  }
+
+  const ivec4* polygons_;
+  const EdgeRecord* edges_;
+  const ObjectRecord* objects_;
+  KernelParams params_;
+  uint features_;
+  std::vector<kernel::KernelEvent>* events_;
+  int max_events_;
+};
+
+// Number of lanes of this target's vectors: the packet size.
+int PacketLanes() {
+  return static_cast<int>(hn::Lanes(D()));
+}
+
+// Marches the packets of the frame's packet grid in rows [row0, row1) and columns [col0, col1)
+// and writes their pixels.
+void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
+  const TileShape tile = tile_shape(PacketLanes());
+  const Marcher marcher(*job.tables, nullptr, 0);
+  const CameraBasis<float>& c = job.basis;
+  const DI di;
+  // Lane l covers pixel (l % tile.width, l / tile.width) of its tile.
+  const VI lane = hn::Iota(di, 0);
+  const VI lane_x = hn::And(lane, SplatI(tile.width - 1));
+  int log2_width = 0;
+  while ((1 << log2_width) < tile.width) ++log2_width;
+  const VI lane_y = hn::ShiftRightSame(lane, log2_width);
+  constexpr size_t kMax = hn::MaxLanes(DI());
+  std::array<float, kMax> red{}, green{}, blue{}, t{};
+  std::array<int32_t, kMax> steps{}, crossings{}, hit{};
+  const V width = Splat(static_cast<float>(job.width));
+  const V height = Splat(static_cast<float>(job.height));
+  for (int row = row0; row < row1; ++row) {
+    for (int col = col0; col < col1; ++col) {
+      const VI i = lane_x + SplatI(col * tile.width), j = lane_y + SplatI(row * tile.height);
+      Packet r;
+      r.done = hn::RebindMask(D(), hn::Or(i > SplatI(job.width - 1), j > SplatI(job.height - 1)));
+      // camera_ray: through the pixel's centre.
+      const V x = hn::ConvertTo(D(), i) + Splat(0.5f), y = hn::ConvertTo(D(), j) + Splat(0.5f);
+      const V u =
+          ((Splat(2.0f) * x / width - Splat(1.0f)) * Splat(c.aspect)) * Splat(c.tan_half_fov);
+      const V v = (Splat(1.0f) - Splat(2.0f) * y / height) * Splat(c.tan_half_fov);
+      V dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
+      V dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
+      V dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
+      const V inv = Splat(1.0f) / hn::Sqrt(dx * dx + dy * dy + dz * dz);
+      dx = dx * inv;
+      dy = dy * inv;
+      dz = dz * inv;
+      marcher.march(r, job.polygon, Splat(job.from.x), Splat(job.from.y), Splat(job.from.z), dx, dy,
+                    dz, *lanes);
+      V cr, cg, cb;
+      marcher.shade(r, job.transmittance, cr, cg, cb);
+      hn::StoreU(cr, D(), red.data());
+      hn::StoreU(cg, D(), green.data());
+      hn::StoreU(cb, D(), blue.data());
+      hn::StoreU(r.t, D(), t.data());
+      hn::StoreU(r.steps, di, steps.data());
+      hn::StoreU(r.crossings, di, crossings.data());
+      hn::StoreU(r.hit, di, hit.data());
+      for (int l = 0; l < tile.width * tile.height; ++l) {
+        const int pi = col * tile.width + l % tile.width, pj = row * tile.height + l / tile.width;
+        if (pi >= job.width || pj >= job.height) continue;
+        const size_t n = static_cast<size_t>(l);
+        job.frame->set(pi, pj, Vec3(red[n], green[n], blue[n]), steps[n], crossings[n], hit[n],
+                       t[n]);
+      }
+    }
+  }
+}
+
+// Follows one ray in lane 0 of a packet, recording at most `max_events` of its events; returns
+// its steps.
+int TraceRay(const PacketJob& job, const Ray& ray, int max_events,
+             std::vector<kernel::KernelEvent>* events) {
+  const Marcher marcher(*job.tables, events, max_events);
+  Packet r;
+  r.done = hn::Not(hn::FirstN(D(), 1));
+  const glm::vec3 from(ray.from), dir(ray.dir);
+  LaneCounts lanes;
+  marcher.march(r, ray.polygon, Splat(from.x), Splat(from.y), Splat(from.z), Splat(dir.x),
+                Splat(dir.y), Splat(dir.z), lanes);
+  return hn::GetLane(r.steps);
+}
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace flatmarch::simd
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace flatmarch::simd {
+
+HWY_EXPORT(PacketLanes);
+HWY_EXPORT(MarchPackets);
+HWY_EXPORT(TraceRay);
+
+int64_t compiled_targets() {
+  return HWY_TARGETS;
+}
+
+PacketCode packet_code(int64_t target) {
+  // HWY_DYNAMIC_DISPATCH picks from the targets hwy::SupportedTargets() reports; to force one,
+  // report only it while the function pointers are taken.
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (target != 0) hwy::SetSupportedTargetsForTest(target);
+  hwy::GetChosenTarget().Update(hwy::SupportedTargets());
+  PacketCode code{&HWY_DYNAMIC_DISPATCH(PacketLanes), &HWY_DYNAMIC_DISPATCH(MarchPackets),
+                  &HWY_DYNAMIC_DISPATCH(TraceRay)};
+  if (target != 0) {
+    hwy::SetSupportedTargetsForTest(0);
+    hwy::GetChosenTarget().Update(hwy::SupportedTargets());
+  }
+  return code;
+}
+
+}  // namespace flatmarch::simd
+#endif

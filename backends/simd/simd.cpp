@@ -1,0 +1,179 @@
+#include "backends/simd/simd.hpp"
+
+#include <hwy/targets.h>
+#include <oneapi/tbb/blocked_range2d.h>
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <array>
+#include <atomic>
+#include <mutex>
+#include <stdexcept>
+#include <utility>
+
+#include "backends/kernel_trace.hpp"
+
+namespace flatmarch {
+
+namespace simd {
+namespace {
+
+// --isa names of the Highway targets packet.cpp may be compiled for, best first.
+constexpr std::array<std::pair<const char*, int64_t>, 4> kIsas{
+    {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4}, {"emu128", HWY_EMU128}}};
+
+// Entries of the transmittance table (per crossing count); rays with more crossings are rare
+// and shaded one by one.
+constexpr int kTransmittanceTable = 4096;
+
+}  // namespace
+
+std::vector<std::string> isa_names(bool supported_only) {
+  std::vector<std::string> names;
+  const int64_t here = supported_only ? hwy::SupportedTargets() : ~int64_t{0};
+  for (const auto& [name, target] : kIsas)
+    if ((compiled_targets() & here & target) != 0) names.emplace_back(name);
+  return names;
+}
+
+}  // namespace simd
+
+SimdBackend::SimdBackend(BackendOptions options) : options_(std::move(options)) {
+  const std::vector<std::string> supported = simd::isa_names(true);
+  if (options_.threads < 0) {
+    unavailable_ = "--threads must be 0 (all cores) or more";
+  } else if (options_.isa.empty()) {
+    isa_ = supported.front();  // emu128 is always there
+  } else if (std::find(supported.begin(), supported.end(), options_.isa) != supported.end()) {
+    isa_ = options_.isa;
+  } else {
+    std::string list;
+    for (const std::string& name : supported) list += (list.empty() ? "" : ", ") + name;
+    const std::vector<std::string> compiled = simd::isa_names(false);
+    const bool known = std::find(compiled.begin(), compiled.end(), options_.isa) != compiled.end();
+    unavailable_ = "instruction set \"" + options_.isa + "\" " +
+                   (known ? "is not supported by this CPU" : "is unknown") +
+                   " (this CPU runs: " + list + ")";
+  }
+  for (const auto& [name, target] : simd::kIsas)
+    if (isa_ == name) target_ = target;
+}
+
+std::string SimdBackend::description() const {
+  return "the kernel on packets of rays with Google Highway (" +
+         (isa_.empty() ? std::string("?") : isa_ + ", " + std::to_string(lanes()) + " lanes") +
+         ") on " +
+         (options_.threads > 0
+              ? std::to_string(options_.threads) + " threads"
+              : "all " + std::to_string(tbb::info::default_concurrency()) + " cores") +
+         " (oneTBB); f32";
+}
+
+Availability SimdBackend::availability() const {
+  if (!unavailable_.empty()) return {false, unavailable_};
+  return {};
+}
+
+simd::PacketCode SimdBackend::code() const {
+  if (target_ == 0) throw std::runtime_error("the simd backend is unavailable: " + unavailable_);
+  // The best target needs no forcing; forcing it anyway would serialise renders on a mutex.
+  const bool best = isa_ == simd::isa_names(true).front();
+  return simd::packet_code(best ? 0 : target_);
+}
+
+int SimdBackend::lanes() const {
+  return target_ == 0 ? 0 : code().lanes();
+}
+
+namespace {
+
+void check_precision(const MarchParams& params) {
+  if (params.precision != Precision::f32)
+    throw std::invalid_argument(
+        "the simd backend marches in f32 only (the scalar backend runs f64)");
+}
+
+// The job of a frame: the compiled scene, the camera and the colour table.
+simd::PacketJob frame_job(const kernel::SceneTables<float>& tables, const Camera& camera, int width,
+                          int height, Frame& frame) {
+  simd::PacketJob job;
+  job.tables = &tables;
+  // As the kernel's shade computes it, in f32.
+  const int size = std::min(tables.params.max_steps, simd::kTransmittanceTable) + 1;
+  const float clear = 1.0f - tables.params.wall_tint;
+  for (int c = 0; c < size; ++c) job.transmittance.push_back(glm::pow(clear, float(c)));
+  job.basis = camera_basis<float>(float(camera.yaw_deg), float(camera.pitch_deg),
+                                  float(camera.fov_deg), width, height);
+  job.polygon = camera.polygon;
+  job.from = glm::vec3(camera.position);
+  job.width = width;
+  job.height = height;
+  job.frame = &frame;
+  return job;
+}
+
+}  // namespace
+
+Frame SimdBackend::render(const Scene& scene, const Camera& camera, int width, int height,
+                          const MarchParams& params, const Progress& progress) const {
+  simd::LaneCounts lanes;
+  return render_counted(scene, camera, width, height, params, progress, lanes);
+}
+
+Frame SimdBackend::render_counted(const Scene& scene, const Camera& camera, int width, int height,
+                                  const MarchParams& params, const Progress& progress,
+                                  simd::LaneCounts& lanes) const {
+  check_precision(params);
+  const simd::PacketCode packets = code();
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+  Frame frame(width, height);
+  const simd::PacketJob job = frame_job(tables, camera, width, height, frame);
+  const simd::TileShape tile = simd::tile_shape(packets.lanes());
+  const int rows = (height + tile.height - 1) / tile.height;
+  const int cols = (width + tile.width - 1) / tile.width;
+
+  std::atomic<int64_t> active{0}, slots{0}, packets_done{0};
+  std::mutex progress_mutex;
+  double reported = 0.0;
+  const double total = static_cast<double>(rows) * cols;
+  tbb::task_arena arena(options_.threads > 0 ? options_.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    // Chunks of 2 x 8 packets (8 x 32 pixels with 16 lanes) at the smallest: enough to spread
+    // a frame's variable cost over the cores, few enough that scheduling costs nothing.
+    tbb::parallel_for(
+        tbb::blocked_range2d<int>(0, rows, 2, 0, cols, 8), [&](const tbb::blocked_range2d<int>& r) {
+          simd::LaneCounts local;
+          packets.march(job, r.rows().begin(), r.rows().end(), r.cols().begin(), r.cols().end(),
+                        &local);
+          active += local.active;
+          slots += local.slots;
+          const int64_t done = packets_done +=
+              static_cast<int64_t>(r.rows().size()) * static_cast<int64_t>(r.cols().size());
+          if (!progress) return;
+          const std::lock_guard<std::mutex> lock(progress_mutex);
+          const double fraction = static_cast<double>(done) / total;
+          if (fraction - reported >= 0.02 || done == rows * int64_t{cols}) {
+            reported = fraction;
+            progress(fraction);
+          }
+        });
+  });
+  lanes.active += active;
+  lanes.slots += slots;
+  return frame;
+}
+
+Trace SimdBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+                         int max_events) const {
+  check_precision(params);
+  const simd::PacketCode packets = code();
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+  simd::PacketJob job;
+  job.tables = &tables;
+  std::vector<kernel::KernelEvent> events;
+  const int steps = packets.trace(job, ray, max_events, &events);
+  return kernel_trace(events, steps);
+}
+
+}  // namespace flatmarch

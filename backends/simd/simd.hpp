@@ -1,0 +1,54 @@
+// The SIMD backend: the kernel on packets of rays (packet.cpp, Google Highway), the best
+// instruction set this CPU has picked at run time, tiles scheduled on all cores with oneTBB.
+// Float32 only.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "backends/backend.hpp"
+#include "backends/simd/packet.hpp"
+
+namespace flatmarch {
+
+namespace simd {
+// Instruction sets by the names --isa takes, best first: those compiled in and, when
+// `supported_only`, those this CPU runs.
+std::vector<std::string> isa_names(bool supported_only);
+}  // namespace simd
+
+class SimdBackend final : public Backend {
+ public:
+  // options.isa: one of simd::isa_names (empty: the best here); options.threads: 0 for all cores.
+  explicit SimdBackend(BackendOptions options = {});
+
+  std::string name() const override { return "simd"; }
+  std::string description() const override;
+  Availability availability() const override;
+  std::vector<Method> methods() const override {
+    return {Method::sphere, Method::relaxed, Method::analytic};
+  }
+  std::vector<Precision> precisions() const override { return {Precision::f32}; }
+  Frame render(const Scene& scene, const Camera& camera, int width, int height,
+               const MarchParams& params, const Progress& progress) const override;
+  Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+              int max_events) const override;
+
+  // render, adding the lane counts of every packet step to `lanes`.
+  Frame render_counted(const Scene& scene, const Camera& camera, int width, int height,
+                       const MarchParams& params, const Progress& progress,
+                       simd::LaneCounts& lanes) const;
+  // The instruction set it runs (--isa's name) and its lanes per packet; "" and 0 if unavailable.
+  std::string isa() const { return isa_; }
+  int lanes() const;
+
+ private:
+  simd::PacketCode code() const;
+
+  BackendOptions options_;
+  int64_t target_ = 0;  // the Highway target; 0 when options_.isa cannot run here
+  std::string isa_, unavailable_;
+};
+
+}  // namespace flatmarch
