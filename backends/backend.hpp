@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kernels/constants.hpp"
@@ -63,13 +64,40 @@ struct Trace {
   int steps = 0;
 };
 
+// An allocator whose new elements are left uninitialised (default-initialised), for buffers
+// that are written in full before they are read.
+template <typename T>
+struct UninitialisedAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  UninitialisedAllocator() = default;
+  template <typename U>
+  explicit UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+// One channel of a frame. A new frame's channels are not zeroed: every backend writes every
+// pixel, and a large frame's memory is then first touched (its pages faulted in) by the
+// threads that render it, in parallel, rather than zeroed beforehand by one.
+using Channel = std::vector<float, UninitialisedAllocator<float>>;
+
 // A rendered frame: colour and the AOVs, row-major with row 0 at the top.
 struct Frame {
   int width = 0, height = 0;
-  std::vector<float> rgb;  // linear colour, 3 floats a pixel
-  std::vector<float> steps, crossings, hit, t;
+  Channel rgb;  // linear colour, 3 floats a pixel
+  Channel steps, crossings, hit, t;
 
   Frame() = default;
+  // Every pixel must then be written (set).
   Frame(int w, int h);
   size_t pixel(int i, int j) const {
     return static_cast<size_t>(j) * static_cast<size_t>(width) + static_cast<size_t>(i);

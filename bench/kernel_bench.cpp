@@ -10,6 +10,7 @@
 #include <numeric>
 
 #include "backends/backend.hpp"
+#include "bench/gallery.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/compile.hpp"
 #include "scene/load.hpp"
@@ -26,16 +27,7 @@ void render_scene(benchmark::State& state, const Backend* backend, const Scene* 
     frame = backend->render(*scene, scene->camera, kWidth, kHeight, params, {});
     benchmark::DoNotOptimize(frame.rgb.data());
   }
-  std::vector<float> steps = frame.steps;
-  std::sort(steps.begin(), steps.end());
-  const double pixels = static_cast<double>(steps.size());
-  state.counters["rays_per_s"] =
-      benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["steps_mean"] = std::accumulate(steps.begin(), steps.end(), 0.0) / pixels;
-  state.counters["steps_p99"] = steps[static_cast<size_t>(0.99 * (pixels - 1))];
-  state.counters["out_of_steps"] =
-      static_cast<double>(std::count(frame.hit.begin(), frame.hit.end(), float(kHitMaxSteps))) /
-      pixels;
+  bench::frame_counters(state, frame);
 }
 
 // The kernel on a scene's tables with extra features switched on: code paths the scene does not
@@ -73,16 +65,10 @@ void extra_features(benchmark::State& state, const Scene* scene, Method method, 
 
 int main(int argc, char** argv) {
   using namespace flatmarch;
-  namespace fs = std::filesystem;
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
 
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(fs::path(FLATMARCH_SOURCE_DIR) / "scenes"))
-    if (entry.path().extension() == ".json") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
-  std::vector<std::unique_ptr<Scene>> scenes;
-  for (const fs::path& f : files) scenes.push_back(std::make_unique<Scene>(load_scene(f)));
+  const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
 
   for (const auto& backend : backends()) {
     if (backend->name() == "oracle") continue;  // not a kernel backend

@@ -120,71 +120,80 @@ class Marcher {
         events_(events),
         max_events_(max_events) {}
 
-  // march.glsl's march() for the lanes not `done` from the start; their steps are counted in
-  // `lanes`.
-  void march(Packet& r, int polygon, V fx, V fy, V fz, V dx, V dy, V dz, LaneCounts& lanes) const {
-    r.polygon = SplatI(polygon);
-    r.ox = fx;
-    r.oy = fy;
-    r.oz = fz;
+  // A packet with no rays: every lane done.
+  static void clear(Packet& r, Relaxation& x, Segment& seg) {
+    r.polygon = r.steps = r.crossings = r.hit = SplatI(0);
+    r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = r.t = Splat(0.0f);
+    r.nx = r.ny = r.nz = r.sr = r.sg = r.sb = Splat(0.0f);
+    r.done = hn::Not(None());
+    x.omega = x.last_radius = x.last_step = Splat(0.0f);
+    seg.known = seg.exit.corner = None();
+    seg.exit.s = seg.solids = Splat(0.0f);
+    seg.exit.edge = SplatI(-1);
+  }
+
+  // The start of march.glsl's march(): the lanes of `m` begin a ray from (fx, fy, fz) in
+  // `polygon` along (dx, dy, dz). The other lanes are left as they are.
+  HWY_INLINE void start(Packet& r, Relaxation& x, Segment& seg, M m, int polygon, V fx, V fy, V fz,
+                        V dx, V dy, V dz) const {
+    r.polygon = Select(m, SplatI(polygon), r.polygon);
+    r.ox = Select(m, fx, r.ox);
+    r.oy = Select(m, fy, r.oy);
+    r.oz = Select(m, fz, r.oz);
     const V inv = Splat(1.0f) / hn::Sqrt(dx * dx + dy * dy + dz * dz);  // normalize
-    r.dx = dx * inv;
-    r.dy = dy * inv;
-    r.dz = dz * inv;
-    r.t = Splat(0.0f);
-    r.steps = SplatI(0);
-    r.crossings = SplatI(0);
-    r.hit = SplatI(kHitMaxSteps);
-    r.nx = r.ny = r.nz = Splat(0.0f);
-    r.sr = r.sg = r.sb = Splat(0.0f);
-    const M live = hn::Not(r.done);
+    r.dx = Select(m, dx * inv, r.dx);
+    r.dy = Select(m, dy * inv, r.dy);
+    r.dz = Select(m, dz * inv, r.dz);
+    r.t = hn::IfThenZeroElse(m, r.t);
+    r.steps = Select(m, SplatI(0), r.steps);
+    r.crossings = Select(m, SplatI(0), r.crossings);
+    r.hit = Select(m, SplatI(kHitMaxSteps), r.hit);
+    r.done = hn::AndNot(m, r.done);
+    // The normal and surface colour are left: only a ray that hits a solid reads them, and the
+    // hit sets them.
     if (has(kFeaturePeriod)) {
       const V top = Splat(params_.top);
-      r.oz = Select(live, r.oz - top * hn::Floor(r.oz / top), r.oz);  // mod
+      r.oz = Select(m, r.oz - top * hn::Floor(r.oz / top), r.oz);  // mod
     } else {
-      const M outside = hn::Or(r.oz<Splat(0.0f), r.oz> Splat(params_.height));
-      enter_band(r, hn::And(live, outside));
+      const M below = hn::Lt(r.oz, Splat(0.0f)), above = hn::Gt(r.oz, Splat(params_.height));
+      enter_band(r, hn::And(m, hn::Or(below, above)));
     }
-    Relaxation x;
-    x.omega = Splat(params_.method == kMethodRelaxed ? params_.omega : 1.0f);  // relax
-    x.last_radius = x.last_step = Splat(0.0f);
-    Segment seg;
-    seg.known = None();
-    seg.exit.s = Splat(kFar);
-    seg.exit.edge = SplatI(-1);
-    seg.exit.corner = None();
-    seg.solids = Splat(kFar);
-    const size_t n = hn::Lanes(D());
+    relax(x, m);
+    seg.known = hn::AndNot(m, seg.known);
+    seg.exit.s = Select(m, Splat(kFar), seg.exit.s);
+    seg.exit.edge = Select(m, SplatI(-1), seg.exit.edge);
+    seg.exit.corner = hn::AndNot(m, seg.exit.corner);
+    seg.solids = Select(m, Splat(kFar), seg.solids);
+  }
+
+  // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
+  // of the rays that have taken max_steps. Each step runs in passes, one per polygon among the
+  // lanes; the rays a pass moves to another room are already out of `pending`.
+  HWY_INLINE void step(Packet& r, Relaxation& x, Segment& seg, LaneCounts& lanes) const {
+    const M active = hn::Not(r.done);
+    r.steps = Select(active, r.steps + SplatI(1), r.steps);
     std::array<int32_t, hn::MaxLanes(DI())> rooms{};
-    for (int i = 0; i < params_.max_steps; ++i) {
-      const M active = hn::Not(r.done);
-      if (!Any(active)) break;
-      r.steps = Select(active, r.steps + SplatI(1), r.steps);
-      // One pass per polygon among the active lanes; the rays a pass moves to another room are
-      // already out of `pending`.
-      hn::StoreU(r.polygon, DI(), rooms.data());
-      M pending = active;
-      while (Any(pending)) {
-        const int room = rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
-        const M pass = hn::And(pending, Equal(r.polygon, room));
-        lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
-        lanes.slots += static_cast<int64_t>(n);
-        if (params_.method == kMethodAnalytic)
-          analytic_step(r, seg, pass, room);
-        else
-          sphere_step(r, x, pass, room);
-        pending = hn::AndNot(pass, pending);
-      }
+    hn::StoreU(r.polygon, DI(), rooms.data());
+    M pending = active;
+    while (Any(pending)) {
+      const int room = rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
+      const M pass = hn::And(pending, Equal(r.polygon, room));
+      lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
+      lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
+      if (params_.method == kMethodAnalytic)
+        analytic_step(r, seg, pass, room);
+      else
+        sphere_step(r, x, pass, room);
+      pending = hn::AndNot(pass, pending);
     }
-    const M unfinished = hn::Not(r.done);
-    if (Any(unfinished))
-      finish(r, unfinished, SplatI(kHitMaxSteps), kEventMaxSteps, SplatI(-1), Splat(0.0f));
+    const M out = hn::AndNot(r.done, hn::RebindMask(D(), r.steps == SplatI(params_.max_steps)));
+    finish(r, out, SplatI(kHitMaxSteps), kEventMaxSteps, SplatI(-1), Splat(0.0f));
   }
 
   // march.glsl's shade(): the linear colour of finished rays. transmittance[c] is
   // (1 - wall_tint)^c as shade computes it, for the first crossing counts.
-  void shade(const Packet& r, const std::vector<float>& transmittance, V& red, V& green,
-             V& blue) const {
+  HWY_INLINE void shade(const Packet& r, const std::vector<float>& transmittance, V& red, V& green,
+                        V& blue) const {
     V cr = Splat(params_.background.x), cg = Splat(params_.background.y);
     V cb = Splat(params_.background.z);
     const M object = AtLeastZero(r.hit);
@@ -232,8 +241,8 @@ class Marcher {
   bool has(uint feature) const { return (features_ & feature) != 0u; }
 
   // Records an event of lane 0 (the one a trace follows) when it is in `m`.
-  void record(M m, int kind, VI polygon, VI edge, int to_polygon, int to_edge, VI hit,
-              const Packet& r) const {
+  HWY_INLINE void record(M m, int kind, VI polygon, VI edge, int to_polygon, int to_edge, VI hit,
+                         const Packet& r) const {
     if (!events_ || static_cast<int>(events_->size()) >= max_events_ ||
         hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1))))
       return;
@@ -243,7 +252,7 @@ class Marcher {
                         glm::dvec3(hn::GetLane(r.ox), hn::GetLane(r.oy), hn::GetLane(r.oz))});
   }
 
-  static void advance(Packet& r, M m, V s) {
+  HWY_INLINE static void advance(Packet& r, M m, V s) {
     r.ox = Select(m, r.ox + s * r.dx, r.ox);
     r.oy = Select(m, r.oy + s * r.dy, r.oy);
     r.oz = Select(m, r.oz + s * r.dz, r.oz);
@@ -251,7 +260,8 @@ class Marcher {
   }
 
   // Ends the rays of `m` `s` further on.
-  void finish(Packet& r, M m, VI hit, int event, VI edge, V s) const {
+  HWY_INLINE void finish(Packet& r, M m, VI hit, int event, VI edge, V s) const {
+    if (!Any(m)) return;
     advance(r, m, s);
     r.hit = Select(m, hit, r.hit);
     r.done = hn::Or(r.done, m);
@@ -261,7 +271,7 @@ class Marcher {
   // ---- Walls ---------------------------------------------------------------------------------
 
   // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a.
-  static M crosses(float ay, float abx, float aby, V py, V apx, V apy) {
+  HWY_INLINE static M crosses(float ay, float abx, float aby, V py, V apx, V apy) {
     const M over_a = py >= Splat(ay);
     const M under_b = py < Splat(ay + aby);
     const M left = Splat(abx) * apy > Splat(aby) * apx;
@@ -269,7 +279,7 @@ class Marcher {
                   hn::Not(hn::Or(hn::Or(over_a, under_b), left)));
   }
 
-  M inside_polygon(int polygon, V px, V py) const {
+  HWY_INLINE M inside_polygon(int polygon, V px, V py) const {
     const ivec4 poly = polygons_[polygon];
     M inside = None();
     for (int k = poly.x; k < poly.x + poly.y; ++k) {
@@ -280,7 +290,7 @@ class Marcher {
     return inside;
   }
 
-  WallDistance wall_distance(int polygon, V px, V py) const {
+  HWY_INLINE WallDistance wall_distance(int polygon, V px, V py) const {
     const ivec4 poly = polygons_[polygon];
     V best = Splat(kFar), second = Splat(kFar);
     VI edge = SplatI(-1);
@@ -308,40 +318,47 @@ class Marcher {
     return w;
   }
 
-  Exit exit_edge(int polygon, V ox, V oy, V dhx, V dhy) const {
+  // For the rays of `m`; an edge none of them moves towards is skipped.
+  HWY_INLINE Exit exit_edge(M m, int polygon, V ox, V oy, V dhx, V dhy) const {
     const ivec4 poly = polygons_[polygon];
     Exit x;
     x.s = Splat(kFar);
     x.edge = SplatI(-1);
-    x.corner = None();
+    V u_exit = Splat(0.5f), tolerance_exit = Splat(0.0f);  // of the exit edge found so far
     const V vertex_tolerance = Splat(params_.vertex_tolerance);
     for (int k = 0; k < poly.y; ++k) {
       const EdgeRecord& e = edges_[poly.x + k];
       const V nx = Splat(e.line.x), ny = Splat(e.line.y);
       const V dn = dhx * nx + dhy * ny;
+      const M towards = hn::And(m, dn > Splat(0.0f));
+      if (!Any(towards)) continue;
       const V s = (Splat(e.line.z) - (ox * nx + oy * ny)) / dn;
-      M ok = hn::And(dn > Splat(0.0f), hn::Not(hn::Or(s < hn::Neg(vertex_tolerance), s >= x.s)));
+      M ok = hn::AndNot(hn::Or(s < hn::Neg(vertex_tolerance), s >= x.s), towards);
+      if (!Any(ok)) continue;  // no ray meets this edge's line before its exit so far
       const float ax = e.segment.x, ay = e.segment.y;
       const V u = (((ox + s * dhx) - Splat(ax)) * Splat(e.segment.z - ax) +
                    ((oy + s * dhy) - Splat(ay)) * Splat(e.segment.w - ay)) *
                   Splat(e.line.w);
-      const float tolerance = params_.vertex_tolerance * std::sqrt(e.line.w);
-      ok = hn::AndNot(hn::Or(u<Splat(-tolerance), u> Splat(1.0f + tolerance)), ok);
+      const V tolerance = Splat(params_.vertex_tolerance * std::sqrt(e.line.w));
+      ok =
+          hn::AndNot(hn::Or(hn::Lt(u, hn::Neg(tolerance)), hn::Gt(u, Splat(1.0f) + tolerance)), ok);
       x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
       x.edge = Select(ok, SplatI(k), x.edge);
-      x.corner = Select(ok, hn::Or(u <= Splat(tolerance), u >= Splat(1.0f - tolerance)), x.corner);
+      u_exit = Select(ok, u, u_exit);
+      tolerance_exit = Select(ok, tolerance, tolerance_exit);
     }
+    x.corner = hn::Or(u_exit <= tolerance_exit, u_exit >= Splat(1.0f) - tolerance_exit);
     return x;
   }
 
-  V band_exit(V oz, V dz) const {
+  HWY_INLINE V band_exit(V oz, V dz) const {
     const V up = (Splat(params_.top) - oz) / dz;
     const V down = hn::Neg(oz) / dz;
     return Select(dz > Splat(0.0f), up, Select(dz < Splat(0.0f), down, Splat(kFar)));
   }
 
   // Moves p along the normal of an edge's line so that it lies `inside` within it.
-  static void place(V& px, V& py, const glm::vec4& line, V inside) {
+  HWY_INLINE static void place(V& px, V& py, const glm::vec4& line, V inside) {
     const V nx = Splat(line.x), ny = Splat(line.y);
     const V k = ((px * nx + py * ny) - Splat(line.z)) + inside;
     px = px - k * nx;
@@ -350,11 +367,15 @@ class Marcher {
 
   // The rays of `m` (in `polygon`) at their edge `edge` go through it or are reflected, and are
   // placed `push` inside the edge they are then behind. One broadcast record per edge.
-  void cross_edge(Packet& r, M m, int polygon, VI edge, V push) const {
+  HWY_INLINE void cross_edge(Packet& r, M m, int polygon, VI edge, V push) const {
     const ivec4 poly = polygons_[polygon];
-    for (int k = 0; k < poly.y; ++k) {
-      const M mk = hn::And(m, Equal(edge, k));
-      if (!Any(mk)) continue;
+    std::array<int32_t, hn::MaxLanes(DI())> lane_edges{};
+    hn::StoreU(edge, DI(), lane_edges.data());
+    // One round per edge the rays cross (usually one or two), not per edge of the polygon.
+    for (M left = m; Any(left);) {
+      const int k = lane_edges[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
+      const M mk = hn::And(left, Equal(edge, k));
+      left = hn::AndNot(mk, left);
       const EdgeRecord& e = edges_[poly.x + k];
       V px = r.ox, py = r.oy;
       V hx = r.dx, hy = r.dy, hz = r.dz;
@@ -369,11 +390,16 @@ class Marcher {
         const ivec4 link = e.link;
         record(mk, kEventGluing, r.polygon, SplatI(k), link.y, link.z, SplatI(-1), r);
         const glm::vec4 a = e.map_linear;
-        const V mx = Splat(a.x), my = Splat(a.y), mz = Splat(a.z), mw = Splat(a.w);
-        px = (mx * r.ox + mz * r.oy) + Splat(e.map_shift.x);
-        py = (my * r.ox + mw * r.oy) + Splat(e.map_shift.y);
-        hx = mx * r.dx + mz * r.dy;
-        hy = my * r.dx + mw * r.dy;
+        if (a == glm::vec4(1.0f, 0.0f, 0.0f, 1.0f)) {  // a translation: what the map gives
+          px = r.ox + Splat(e.map_shift.x);
+          py = r.oy + Splat(e.map_shift.y);
+        } else {
+          const V mx = Splat(a.x), my = Splat(a.y), mz = Splat(a.z), mw = Splat(a.w);
+          px = (mx * r.ox + mz * r.oy) + Splat(e.map_shift.x);
+          py = (my * r.ox + mw * r.oy) + Splat(e.map_shift.y);
+          hx = mx * r.dx + mz * r.dy;
+          hy = my * r.dx + mw * r.dy;
+        }
         place(px, py, edges_[polygons_[link.y].x + link.z].line, push);
         if (has(kFeatureScaled)) {  // normalize
           const V inv = Splat(1.0f) / hn::Sqrt(hx * hx + hy * hy + hz * hz);
@@ -393,7 +419,7 @@ class Marcher {
   }
 
   // Which lanes' `edge` of `polygon` is an opaque wall.
-  M is_wall(int polygon, VI edge) const {
+  HWY_INLINE M is_wall(int polygon, VI edge) const {
     M wall = None();
     if (!has(kFeatureWalls)) return wall;
     const ivec4 poly = polygons_[polygon];
@@ -403,7 +429,7 @@ class Marcher {
   }
 
   // The rays of `m` reach the top or bottom of the band, `s` further on.
-  void leave_band(Packet& r, M m, V s) const {
+  HWY_INLINE void leave_band(Packet& r, M m, V s) const {
     if (has(kFeaturePeriod)) {
       advance(r, m, s);
       r.oz = Select(m, Select(r.dz > Splat(0.0f), Splat(0.0f), Splat(params_.top)), r.oz);
@@ -419,7 +445,7 @@ class Marcher {
 
   // ---- Solids --------------------------------------------------------------------------------
 
-  V solid_distance(int k, V px, V py, V pz) const {
+  HWY_INLINE V solid_distance(int k, V px, V py, V pz) const {
     const ObjectRecord& o = objects_[k];
     const V qx = px - Splat(o.center.x), qy = py - Splat(o.center.y);
     const V qz = pz - Splat(o.center.z);
@@ -441,7 +467,7 @@ class Marcher {
     return hn::Max(box, Splat(o.shape.w) - hn::Sqrt(qx * qx + qy * qy + qz * qz));
   }
 
-  SolidDistance nearest_solid(int polygon, V px, V py, V pz) const {
+  HWY_INLINE SolidDistance nearest_solid(int polygon, V px, V py, V pz) const {
     SolidDistance best;
     best.d = Splat(kFar);
     best.object = SplatI(-1);
@@ -457,7 +483,7 @@ class Marcher {
   }
 
   // Where a ray first comes within eps of a solid's bounding sphere in its room, or kFar.
-  V solid_entry(int polygon, const Packet& r) const {
+  HWY_INLINE V solid_entry(int polygon, const Packet& r) const {
     const ivec4 poly = polygons_[polygon];
     V first = Splat(kFar);
     M inside = None();
@@ -476,7 +502,7 @@ class Marcher {
   }
 
   // The gradient of solid k's distance at p by central differences on a tetrahedron.
-  void solid_normal(int k, V px, V py, V pz, V& nx, V& ny, V& nz) const {
+  HWY_INLINE void solid_normal(int k, V px, V py, V pz, V& nx, V& ny, V& nz) const {
     const V h = Splat(params_.normal_step);
     const V s1 = solid_distance(k, px + h, py - h, pz - h);  // (1, -1, -1)
     const V s2 = solid_distance(k, px - h, py - h, pz + h);  // (-1, -1, 1)
@@ -492,7 +518,7 @@ class Marcher {
   }
 
   // The rays of `m` hit their `object` of `polygon` where they are.
-  void hit_solid(Packet& r, M m, int polygon, VI object) const {
+  HWY_INLINE void hit_solid(Packet& r, M m, int polygon, VI object) const {
     const ivec4 poly = polygons_[polygon];
     for (int k = poly.z; k < poly.z + poly.w; ++k) {
       const M mk = hn::And(m, Equal(object, k));
@@ -513,7 +539,7 @@ class Marcher {
 
   // ---- Methods -------------------------------------------------------------------------------
 
-  void relax(Relaxation& x, M m) const {
+  HWY_INLINE void relax(Relaxation& x, M m) const {
     const V omega = Splat(params_.method == kMethodRelaxed ? params_.omega : 1.0f);
     x.omega = Select(m, omega, x.omega);
     x.last_radius = hn::IfThenZeroElse(m, x.last_radius);
@@ -521,7 +547,7 @@ class Marcher {
   }
 
   // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `polygon`.
-  void sphere_step(Packet& r, Relaxation& x, M m, int polygon) const {
+  HWY_INLINE void sphere_step(Packet& r, Relaxation& x, M m, int polygon) const {
     const WallDistance wall = wall_distance(polygon, r.ox, r.oy);
     const SolidDistance solid = nearest_solid(polygon, r.ox, r.oy, r.oz);
     const V radius = hn::Min(wall.d, solid.d);
@@ -570,17 +596,17 @@ class Marcher {
     advance(r, rest, x.last_step);
   }
 
-  static void move_in_segment(Packet& r, Segment& seg, M m, V s) {
+  HWY_INLINE static void move_in_segment(Packet& r, Segment& seg, M m, V s) {
     advance(r, m, s);
     seg.exit.s = Select(m, seg.exit.s - s, seg.exit.s);
     seg.solids = Select(m, hn::Max(seg.solids - s, Splat(0.0f)), seg.solids);
   }
 
   // One iteration of the analytic method for the rays of `m`, in `polygon`.
-  void analytic_step(Packet& r, Segment& seg, M m, int polygon) const {
+  HWY_INLINE void analytic_step(Packet& r, Segment& seg, M m, int polygon) const {
     const M unknown = hn::AndNot(seg.known, m);
     if (Any(unknown)) {
-      const Exit x = exit_edge(polygon, r.ox, r.oy, r.dx, r.dy);
+      const Exit x = exit_edge(unknown, polygon, r.ox, r.oy, r.dx, r.dy);
       seg.exit.s = Select(unknown, x.s, seg.exit.s);
       seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
       seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
@@ -592,24 +618,23 @@ class Marcher {
     }
     const V max_distance = Splat(params_.max_distance);
     V remaining = max_distance - r.t;
+    V band = band_exit(r.oz, r.dz);  // recomputed below for the rays that move
     M rest = m;
     if (has(kFeatureObjects)) {
-      const M solids =
-          hn::And(m, seg.solids < hn::Min(hn::Min(seg.exit.s, band_exit(r.oz, r.dz)), remaining));
+      const M solids = hn::And(m, seg.solids < hn::Min(hn::Min(seg.exit.s, band), remaining));
       if (Any(solids)) {
         move_in_segment(r, seg, solids, seg.solids);
+        band = Select(solids, band_exit(r.oz, r.dz), band);
         const SolidDistance solid = nearest_solid(polygon, r.ox, r.oy, r.oz);
         const M hit = hn::And(solids, solid.d < Splat(params_.eps));
         hit_solid(r, hit, polygon, solid.object);
         const M on = hn::AndNot(hit, solids);
         remaining = Select(on, max_distance - r.t, remaining);
-        const M step =
-            hn::And(on, solid.d < hn::Min(hn::Min(seg.exit.s, band_exit(r.oz, r.dz)), remaining));
+        const M step = hn::And(on, solid.d < hn::Min(hn::Min(seg.exit.s, band), remaining));
         move_in_segment(r, seg, step, solid.d);
         rest = hn::AndNot(hn::Or(hit, step), rest);
       }
     }
-    const V band = band_exit(r.oz, r.dz);
     const M far = hn::And(rest, remaining < hn::Min(seg.exit.s, band));
     finish(r, far, SplatI(kHitMaxDistance), kEventMaxDistance, SplatI(-1), remaining);
     rest = hn::AndNot(far, rest);
@@ -637,7 +662,7 @@ class Marcher {
   // ---- A whole ray ---------------------------------------------------------------------------
 
   // The rays of `m`, outside the band, enter the first polygon whose footprint they cross.
-  void enter_band(Packet& r, M m) const {
+  HWY_INLINE void enter_band(Packet& r, M m) const {
     if (!Any(m)) return;
     const V height = Splat(params_.height), max_distance = Splat(params_.max_distance);
     const M above = r.oz > height;
@@ -683,43 +708,48 @@ int PacketLanes() {
   return static_cast<int>(hn::Lanes(D()));
 }
 
-// Marches the packets of the frame's packet grid in rows [row0, row1) and columns [col0, col1)
-// and writes their pixels.
+// Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
+// grid of tiles and writes them. The lanes of one packet take the chunk's pixels tile by tile,
+// and a lane whose ray has ended takes the next pixel at once, so that a few long rays do not
+// hold up the rest of their tile (lanes stay busy until the chunk's pixels run out).
+#ifndef FLATMARCH_REFILL_AT
+#define FLATMARCH_REFILL_AT 2
+#endif
+constexpr size_t kRefillAt = FLATMARCH_REFILL_AT;  // eighths of the lanes
 void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
   const TileShape tile = tile_shape(PacketLanes());
   const Marcher marcher(*job.tables, nullptr, 0);
   const CameraBasis<float>& c = job.basis;
   const DI di;
-  // Lane l covers pixel (l % tile.width, l / tile.width) of its tile.
-  const VI lane = hn::Iota(di, 0);
-  const VI lane_x = hn::And(lane, SplatI(tile.width - 1));
-  int log2_width = 0;
-  while ((1 << log2_width) < tile.width) ++log2_width;
-  const VI lane_y = hn::ShiftRightSame(lane, log2_width);
   constexpr size_t kMax = hn::MaxLanes(DI());
+  const size_t n = hn::Lanes(D());
   std::array<float, kMax> red{}, green{}, blue{}, t{};
-  std::array<int32_t, kMax> steps{}, crossings{}, hit{};
+  std::array<int32_t, kMax> steps{}, crossings{}, hit{}, fresh{};
+  std::array<int32_t, kMax> pixel_i{}, pixel_j{};
+  pixel_i.fill(-1);  // -1: the lane holds no pixel
   const V width = Splat(static_cast<float>(job.width));
   const V height = Splat(static_cast<float>(job.height));
-  for (int row = row0; row < row1; ++row) {
-    for (int col = col0; col < col1; ++col) {
-      const VI i = lane_x + SplatI(col * tile.width), j = lane_y + SplatI(row * tile.height);
-      Packet r;
-      r.done = hn::RebindMask(D(), hn::Or(i > SplatI(job.width - 1), j > SplatI(job.height - 1)));
-      // camera_ray: through the pixel's centre.
-      const V x = hn::ConvertTo(D(), i) + Splat(0.5f), y = hn::ConvertTo(D(), j) + Splat(0.5f);
-      const V u =
-          ((Splat(2.0f) * x / width - Splat(1.0f)) * Splat(c.aspect)) * Splat(c.tan_half_fov);
-      const V v = (Splat(1.0f) - Splat(2.0f) * y / height) * Splat(c.tan_half_fov);
-      V dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
-      V dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
-      V dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
-      const V inv = Splat(1.0f) / hn::Sqrt(dx * dx + dy * dy + dz * dz);
-      dx = dx * inv;
-      dy = dy * inv;
-      dz = dz * inv;
-      marcher.march(r, job.polygon, Splat(job.from.x), Splat(job.from.y), Splat(job.from.z), dx, dy,
-                    dz, *lanes);
+  const V from_x = Splat(job.from.x), from_y = Splat(job.from.y), from_z = Splat(job.from.z);
+
+  // The chunk's pixels in queue order: tile by tile, row-major; lane order within a tile.
+  const int tiles_across = col1 - col0;
+  const int64_t queue = int64_t{row1 - row0} * tiles_across * tile.width * tile.height;
+  int64_t next = 0;
+  Packet r;
+  Relaxation x;
+  Segment seg;
+  Marcher::clear(r, x, seg);
+  // Every iteration steps at least one ray, and a ray takes at most max_steps steps.
+  const int64_t bound = queue * (int64_t{job.tables->params.max_steps} + 1) + 1;
+  M occupied = None();  // lanes holding a pixel
+  for (int64_t iteration = 0; iteration < bound; ++iteration) {
+    // Lanes are refilled once enough of them wait (each refill costs a shading and a camera
+    // ray for the whole packet), or when none is left marching.
+    const M waiting = next < queue ? r.done : hn::And(r.done, occupied);
+    const size_t count = hn::CountTrue(D(), waiting);
+    bool refill = false;
+    if (count > 0 && (count >= kRefillAt * n / 8 || hn::AllTrue(D(), r.done))) {
+      // Write out the rays that have ended, then give their lanes the next pixels.
       V cr, cg, cb;
       marcher.shade(r, job.transmittance, cr, cg, cb);
       hn::StoreU(cr, D(), red.data());
@@ -729,14 +759,54 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       hn::StoreU(r.steps, di, steps.data());
       hn::StoreU(r.crossings, di, crossings.data());
       hn::StoreU(r.hit, di, hit.data());
-      for (int l = 0; l < tile.width * tile.height; ++l) {
-        const int pi = col * tile.width + l % tile.width, pj = row * tile.height + l / tile.width;
-        if (pi >= job.width || pj >= job.height) continue;
-        const size_t n = static_cast<size_t>(l);
-        job.frame->set(pi, pj, Vec3(red[n], green[n], blue[n]), steps[n], crossings[n], hit[n],
-                       t[n]);
+      fresh.fill(0);
+      uint8_t bits[8] = {};
+      hn::StoreMaskBits(D(), waiting, bits);
+      uint64_t lanes_waiting = 0;
+      for (size_t b = 0; b < 8; ++b) lanes_waiting |= uint64_t{bits[b]} << (8 * b);
+      for (; lanes_waiting != 0; lanes_waiting &= lanes_waiting - 1) {
+        const size_t l = static_cast<size_t>(hwy::Num0BitsBelowLS1Bit_Nonzero64(lanes_waiting));
+        if (pixel_i[l] >= 0)
+          job.frame->set(pixel_i[l], pixel_j[l], Vec3(red[l], green[l], blue[l]), steps[l],
+                         crossings[l], hit[l], t[l]);
+        pixel_i[l] = -1;
+        while (next < queue && pixel_i[l] < 0) {
+          const int64_t tile_index = next / static_cast<int64_t>(n);
+          const int lane = static_cast<int>(next % static_cast<int64_t>(n));
+          ++next;
+          const int i =
+              (col0 + static_cast<int>(tile_index % tiles_across)) * tile.width + lane % tile.width;
+          const int j = (row0 + static_cast<int>(tile_index / tiles_across)) * tile.height +
+                        lane / tile.width;
+          if (i >= job.width || j >= job.height) continue;
+          pixel_i[l] = i;
+          pixel_j[l] = j;
+          fresh[l] = -1;
+          refill = true;
+        }
       }
+      occupied = hn::RebindMask(D(), hn::Gt(hn::LoadU(di, pixel_i.data()), SplatI(-1)));
     }
+    if (refill) {
+      const M m = hn::RebindMask(D(), hn::MaskFromVec(hn::LoadU(di, fresh.data())));
+      // camera_ray: through the pixel's centre.
+      const V px = hn::ConvertTo(D(), hn::LoadU(di, pixel_i.data())) + Splat(0.5f);
+      const V py = hn::ConvertTo(D(), hn::LoadU(di, pixel_j.data())) + Splat(0.5f);
+      const V u =
+          ((Splat(2.0f) * px / width - Splat(1.0f)) * Splat(c.aspect)) * Splat(c.tan_half_fov);
+      const V v = (Splat(1.0f) - Splat(2.0f) * py / height) * Splat(c.tan_half_fov);
+      V dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
+      V dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
+      V dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
+      const V inv = Splat(1.0f) / hn::Sqrt(dx * dx + dy * dy + dz * dz);
+      dx = dx * inv;
+      dy = dy * inv;
+      dz = dz * inv;
+      marcher.start(r, x, seg, m, job.polygon, from_x, from_y, from_z, dx, dy, dz);
+      continue;  // a ray may end as it starts (a miss): write it out before stepping
+    }
+    if (hn::AllTrue(D(), r.done)) break;  // no pixels left and every ray written
+    marcher.step(r, x, seg, *lanes);
   }
 }
 
@@ -746,11 +816,15 @@ int TraceRay(const PacketJob& job, const Ray& ray, int max_events,
              std::vector<kernel::KernelEvent>* events) {
   const Marcher marcher(*job.tables, events, max_events);
   Packet r;
-  r.done = hn::Not(hn::FirstN(D(), 1));
+  Relaxation x;
+  Segment seg;
+  Marcher::clear(r, x, seg);
   const glm::vec3 from(ray.from), dir(ray.dir);
+  marcher.start(r, x, seg, hn::FirstN(D(), 1), ray.polygon, Splat(from.x), Splat(from.y),
+                Splat(from.z), Splat(dir.x), Splat(dir.y), Splat(dir.z));
   LaneCounts lanes;
-  marcher.march(r, ray.polygon, Splat(from.x), Splat(from.y), Splat(from.z), Splat(dir.x),
-                Splat(dir.y), Splat(dir.z), lanes);
+  for (int i = 0; i < job.tables->params.max_steps && !hn::AllTrue(D(), r.done); ++i)
+    marcher.step(r, x, seg, lanes);
   return hn::GetLane(r.steps);
 }
 

@@ -1,0 +1,44 @@
+// What the benchmark programs share: the gallery scenes and the counters of a rendered frame.
+#pragma once
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <numeric>
+#include <vector>
+
+#include "backends/backend.hpp"
+#include "scene/load.hpp"
+
+namespace flatmarch::bench {
+
+// The gallery scenes (scenes/*.json), sorted by file name; pointers stay valid for benchmarks.
+inline std::vector<std::unique_ptr<Scene>> load_gallery() {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::filesystem::path(FLATMARCH_SOURCE_DIR) / "scenes"))
+    if (entry.path().extension() == ".json") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  std::vector<std::unique_ptr<Scene>> scenes;
+  for (const auto& f : files) scenes.push_back(std::make_unique<Scene>(load_scene(f)));
+  return scenes;
+}
+
+// rays_per_s, and the deterministic figures of the last frame: steps_mean, steps_p99,
+// out_of_steps (share of rays that reached max_steps).
+inline void frame_counters(benchmark::State& state, const Frame& frame) {
+  std::vector<float> steps(frame.steps.begin(), frame.steps.end());
+  std::sort(steps.begin(), steps.end());
+  const double pixels = static_cast<double>(steps.size());
+  state.counters["rays_per_s"] =
+      benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["steps_mean"] = std::accumulate(steps.begin(), steps.end(), 0.0) / pixels;
+  state.counters["steps_p99"] = steps[static_cast<size_t>(0.99 * (pixels - 1))];
+  state.counters["out_of_steps"] =
+      static_cast<double>(std::count(frame.hit.begin(), frame.hit.end(), float(kHitMaxSteps))) /
+      pixels;
+}
+
+}  // namespace flatmarch::bench

@@ -1,0 +1,100 @@
+// The SIMD backend at 640x360 from each scene's own camera: rays per second and lane utilisation
+// (active lanes over lanes, summed over every pass of every packet step), per gallery scene and
+// method, on all cores with the best instruction set here. For the L-shape and the double
+// pentagon it also runs, side by side in one run, the scalar backend, the SIMD backend on one
+// thread, and every instruction set on one thread: bench/speedups.py turns the JSON into the
+// ratios (SIMD on all cores over scalar, all cores over one thread).
+//
+//   simd_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+//              --benchmark_out=simd.json --benchmark_out_format=json   (one line)
+//   python3 bench/speedups.py simd.json
+//
+// Names: scalar/METHOD/SCENE and simd/METHOD/SCENE/ISA/threads:N.
+#include <benchmark/benchmark.h>
+
+#include <oneapi/tbb/info.h>
+
+#include <iostream>
+#include <string>
+
+#include "backends/scalar/scalar.hpp"
+#include "backends/simd/simd.hpp"
+#include "bench/gallery.hpp"
+
+namespace flatmarch {
+namespace {
+
+constexpr int kWidth = 640, kHeight = 360;
+
+void simd_frame(benchmark::State& state, const Scene* scene, MarchParams params,
+                BackendOptions options) {
+  const SimdBackend simd(options);
+  Frame frame;
+  simd::LaneCounts lanes;
+  for (auto _ : state) {
+    lanes = {};
+    frame = simd.render_counted(*scene, scene->camera, kWidth, kHeight, params, {}, lanes);
+    benchmark::DoNotOptimize(frame.rgb.data());
+  }
+  bench::frame_counters(state, frame);
+  state.counters["lane_utilisation"] =
+      static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
+  state.counters["lanes"] = simd.lanes();
+}
+
+void scalar_frame(benchmark::State& state, const Scene* scene, MarchParams params) {
+  const ScalarBackend scalar;
+  Frame frame;
+  for (auto _ : state) {
+    frame = scalar.render(*scene, scene->camera, kWidth, kHeight, params, {});
+    benchmark::DoNotOptimize(frame.rgb.data());
+  }
+  bench::frame_counters(state, frame);
+}
+
+}  // namespace
+}  // namespace flatmarch
+
+int main(int argc, char** argv) {
+  using namespace flatmarch;
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+
+  const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
+  const std::vector<std::string> isas = simd::isa_names(true);
+  const int cores = tbb::info::default_concurrency();
+  std::cerr << "simd_bench: " << cores << " cores; instruction sets here:";
+  for (const std::string& isa : isas) std::cerr << " " << isa;
+  std::cerr << "\n";
+
+  const auto simd_case = [&](const Scene* scene, Method method, const std::string& isa,
+                             int threads) {
+    MarchParams params;
+    params.method = method;
+    const std::string name = std::string("simd/") + to_string(method) + "/" + scene->name + "/" +
+                             isa + "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(name.c_str(), simd_frame, scene, params,
+                                 BackendOptions{.isa = isa, .threads = threads})
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  };
+  for (Method method : {Method::sphere, Method::relaxed, Method::analytic}) {
+    for (const auto& scene : scenes) {
+      const bool compared = scene->name == "l_shape" || scene->name == "double_pentagon";
+      if (compared) {
+        MarchParams params;
+        params.method = method;
+        benchmark::RegisterBenchmark(
+            (std::string("scalar/") + to_string(method) + "/" + scene->name).c_str(), scalar_frame,
+            scene.get(), params)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+        for (const std::string& isa : isas) simd_case(scene.get(), method, isa, 1);
+      }
+      if (!compared || cores > 1) simd_case(scene.get(), method, isas.front(), cores);
+    }
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
