@@ -5,11 +5,11 @@
 // -ffp-contract=off), so that a lane takes exactly the steps the scalar backend takes.
 //
 // What differs is control flow. Where the kernel branches, a packet computes under masks and
-// blends. The tables are read per polygon, not per lane: each step runs in passes, one per
-// polygon among the packet's unfinished rays, and in a pass every table read is one record
-// broadcast to all lanes (a coherent tile's rays are mostly in the same room, so this usually
-// means one pass a step; no gathers). Finished lanes are masked off; the share of lanes doing
-// work in a pass is the lane utilisation the benchmark reports.
+// blends. The tables are read per room, not per lane: a step runs in passes over a few rooms
+// among the packet's unfinished rays, and a table read is one record per room, broadcast and
+// blended (a coherent tile's rays are mostly in one room, so this is usually one broadcast; no
+// gathers). A lane whose ray has ended is masked off until it takes the next pixel; the share
+// of lanes doing work in a pass is the lane utilisation the benchmark reports.
 //
 // This file is compiled once per instruction set (hwy/foreach_target.h) and the best one the CPU
 // supports is picked at run time (HWY_DYNAMIC_DISPATCH; simd.cpp can force one).
@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <mutex>
 
 #include "backends/simd/packet.hpp"
@@ -108,17 +109,71 @@ struct Segment {
   V solids;
 };
 
+// The rooms of one pass: the polygons its rays are in (at most kRoomsPerPass) and the lanes in
+// each. A table read gives every lane its own room's record: a broadcast of the first room's,
+// blended with the others'. Coherent rays are mostly in one room, where a read is a broadcast;
+// rays split between a few rooms (the double pentagon's two, at every crossing) still take one
+// pass a step, not one per room.
+constexpr int kRoomsPerPass = 4;
+struct Rooms {
+  int count = 0;
+  int most_edges = 0;
+  std::array<int, kRoomsPerPass> polygon{};
+  std::array<M, kRoomsPerPass> lanes;  // the lanes in each
+  M all;                               // the lanes of the pass
+  VI first_edge, edge_count;           // of each lane's room, when there are several
+};
+
+// The numbers of an edge the packet code reads, by name.
+enum Field { kAx, kAy, kAbx, kAby, kAyAby, kNx, kNy, kNa, kInvLength2, kTolerance, kFields };
+inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra) {
+  switch (f) {
+    case kAx:
+      return e.segment.x;
+    case kAy:
+      return e.segment.y;
+    case kAbx:
+      return extra.x;
+    case kAby:
+      return extra.y;
+    case kAyAby:
+      return extra.w;
+    case kNx:
+      return e.line.x;
+    case kNy:
+      return e.line.y;
+    case kNa:
+      return e.line.z;
+    case kInvLength2:
+      return e.line.w;
+    case kTolerance:
+      return extra.z;
+    case kFields:
+      break;
+  }
+  return 0.0f;
+}
+
 class Marcher {
  public:
-  Marcher(const kernel::SceneTables<float>& tables, std::vector<kernel::KernelEvent>* events,
-          int max_events)
+  Marcher(const kernel::SceneTables<float>& tables, const std::vector<glm::vec4>& edge_extra,
+          std::vector<kernel::KernelEvent>* events, int max_events)
       : polygons_(tables.polygons.data()),
         edges_(tables.edges.data()),
+        extra_(edge_extra.data()),
         objects_(tables.objects.data()),
         params_(tables.params),
         features_(tables.features),
         events_(events),
-        max_events_(max_events) {}
+        max_events_(max_events) {
+    // Passes over several rooms read the edges by lane from vectors: possible when the scene's
+    // edges fit in one.
+    merge_ = tables.edges.size() <= hn::Lanes(D());
+    if (!merge_) return;
+    for (size_t f = 0; f < kFields; ++f)
+      for (size_t e = 0; e < tables.edges.size(); ++e)
+        lookup_[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], edge_extra[e]);
+  }
 
   // A packet with no rays: every lane done.
   static void clear(Packet& r, Relaxation& x, Segment& seg) {
@@ -167,23 +222,43 @@ class Marcher {
   }
 
   // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
-  // of the rays that have taken max_steps. Each step runs in passes, one per polygon among the
-  // lanes; the rays a pass moves to another room are already out of `pending`.
+  // of the rays that have taken max_steps. A step runs in passes of up to kRoomsPerPass rooms
+  // (usually one pass); the rays a pass moves to another room are already out of `pending`.
   HWY_INLINE void step(Packet& r, Relaxation& x, Segment& seg, LaneCounts& lanes) const {
     const M active = hn::Not(r.done);
     r.steps = Select(active, r.steps + SplatI(1), r.steps);
-    std::array<int32_t, hn::MaxLanes(DI())> rooms{};
-    hn::StoreU(r.polygon, DI(), rooms.data());
+    std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
+    hn::StoreU(r.polygon, DI(), lane_rooms.data());
     M pending = active;
     while (Any(pending)) {
-      const int room = rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
-      const M pass = hn::And(pending, Equal(r.polygon, room));
+      Rooms rooms;
+      M pass = None();
+      rooms.first_edge = rooms.edge_count = SplatI(0);
+      const int most_rooms = merge_ ? kRoomsPerPass : 1;
+      for (M left = pending; Any(left) && rooms.count < most_rooms; ++rooms.count) {
+        const int polygon = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
+        const M in = hn::And(left, Equal(r.polygon, polygon));
+        const ivec4 poly = polygons_[polygon];
+        rooms.polygon[static_cast<size_t>(rooms.count)] = polygon;
+        rooms.lanes[static_cast<size_t>(rooms.count)] = in;
+        rooms.most_edges = std::max(rooms.most_edges, poly.y);
+        rooms.first_edge = Select(in, SplatI(poly.x), rooms.first_edge);
+        rooms.edge_count = Select(in, SplatI(poly.y), rooms.edge_count);
+        pass = hn::Or(pass, in);
+        left = hn::AndNot(in, left);
+      }
+      rooms.all = pass;
       lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
       lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
-      if (params_.method == kMethodAnalytic)
-        analytic_step(r, seg, pass, room);
+      const bool analytic = params_.method == kMethodAnalytic;
+      if (rooms.count == 1 && analytic)
+        analytic_step<true>(r, seg, pass, rooms);
+      else if (rooms.count == 1)
+        sphere_step<true>(r, x, pass, rooms);
+      else if (analytic)
+        analytic_step<false>(r, seg, pass, rooms);
       else
-        sphere_step(r, x, pass, room);
+        sphere_step<false>(r, x, pass, rooms);
       pending = hn::AndNot(pass, pending);
     }
     const M out = hn::AndNot(r.done, hn::RebindMask(D(), r.steps == SplatI(params_.max_steps)));
@@ -270,11 +345,42 @@ class Marcher {
 
   // ---- Walls ---------------------------------------------------------------------------------
 
-  // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a.
-  HWY_INLINE static M crosses(float ay, float abx, float aby, V py, V apx, V apy) {
-    const M over_a = py >= Splat(ay);
-    const M under_b = py < Splat(ay + aby);
-    const M left = Splat(abx) * apy > Splat(aby) * apx;
+  // Edge k of each lane's room: its index in the edge table (0 where the room has fewer
+  // edges), and the lanes whose room has one.
+  struct Slot {
+    int edge;  // in one room
+    VI edges;  // in several
+    M valid;
+  };
+  template <bool kOneRoom>
+  HWY_INLINE Slot slot(const Rooms& rooms, int k) const {
+    Slot at;
+    if constexpr (kOneRoom) {
+      at.edge = polygons_[rooms.polygon[0]].x + k;
+      at.valid = rooms.lanes[0];
+    } else {
+      at.edge = 0;
+      at.valid = hn::And(rooms.all, hn::RebindMask(D(), SplatI(k) < rooms.edge_count));
+      at.edges = Select(at.valid, rooms.first_edge + SplatI(k), SplatI(0));
+    }
+    return at;
+  }
+
+  // Number `f` of each lane's edge in `at`: in one room a broadcast, in several a lookup in
+  // the scene's edge numbers held in vectors (lookup_).
+  template <bool kOneRoom>
+  HWY_INLINE V field(const Slot& at, Field f) const {
+    if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
+    return hn::TableLookupLanes(hn::LoadU(D(), lookup_[f].data()),
+                                hn::IndicesFromVec(D(), at.edges));
+  }
+
+  // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a,
+  // ay_aby = a.y + ab.y.
+  HWY_INLINE static M crosses(V ay, V ay_aby, V abx, V aby, V py, V apx, V apy) {
+    const M over_a = py >= ay;
+    const M under_b = py < ay_aby;
+    const M left = abx * apy > aby * apx;
     return hn::Or(hn::And(hn::And(over_a, under_b), left),
                   hn::Not(hn::Or(hn::Or(over_a, under_b), left)));
   }
@@ -284,31 +390,37 @@ class Marcher {
     M inside = None();
     for (int k = poly.x; k < poly.x + poly.y; ++k) {
       const glm::vec4 s = edges_[k].segment;
+      const glm::vec4 x = extra_[k];
       const V apx = px - Splat(s.x), apy = py - Splat(s.y);
-      inside = hn::Xor(inside, crosses(s.y, s.z - s.x, s.w - s.y, py, apx, apy));
+      inside =
+          hn::Xor(inside, crosses(Splat(s.y), Splat(x.w), Splat(x.x), Splat(x.y), py, apx, apy));
     }
     return inside;
   }
 
-  HWY_INLINE WallDistance wall_distance(int polygon, V px, V py) const {
-    const ivec4 poly = polygons_[polygon];
+  template <bool kOneRoom>
+  HWY_INLINE WallDistance wall_distance(const Rooms& rooms, V px, V py) const {
     V best = Splat(kFar), second = Splat(kFar);
     VI edge = SplatI(-1);
     M inside = None();
-    for (int k = 0; k < poly.y; ++k) {
-      const EdgeRecord& e = edges_[poly.x + k];
-      const float abx = e.segment.z - e.segment.x, aby = e.segment.w - e.segment.y;
-      const V apx = px - Splat(e.segment.x), apy = py - Splat(e.segment.y);
-      const V h =
-          hn::Min(hn::Max((apx * Splat(abx) + apy * Splat(aby)) * Splat(e.line.w), Splat(0.0f)),
-                  Splat(1.0f));
-      const V qx = apx - h * Splat(abx), qy = apy - h * Splat(aby);
+    for (int k = 0; k < rooms.most_edges; ++k) {
+      const Slot at = slot<kOneRoom>(rooms, k);
+      const M valid = at.valid;
+      const V ax = field<kOneRoom>(at, kAx);
+      const V ay = field<kOneRoom>(at, kAy);
+      const V abx = field<kOneRoom>(at, kAbx);
+      const V aby = field<kOneRoom>(at, kAby);
+      const V w = field<kOneRoom>(at, kInvLength2);
+      const V ay_aby = field<kOneRoom>(at, kAyAby);
+      const V apx = px - ax, apy = py - ay;
+      const V h = hn::Min(hn::Max((apx * abx + apy * aby) * w, Splat(0.0f)), Splat(1.0f));
+      const V qx = apx - h * abx, qy = apy - h * aby;
       const V d2 = qx * qx + qy * qy;
-      const M nearest = d2 < best;
-      second = Select(nearest, best, Select(d2 < second, d2, second));
+      const M nearest = hn::And(valid, d2 < best);
+      second = Select(nearest, best, Select(hn::And(valid, d2 < second), d2, second));
       best = Select(nearest, d2, best);
       edge = Select(nearest, SplatI(k), edge);
-      inside = hn::Xor(inside, crosses(e.segment.y, abx, aby, py, apx, apy));
+      inside = hn::Xor(inside, hn::And(valid, crosses(ay, ay_aby, abx, aby, py, apx, apy)));
     }
     WallDistance w;
     const V root = hn::Sqrt(best);
@@ -319,27 +431,31 @@ class Marcher {
   }
 
   // For the rays of `m`; an edge none of them moves towards is skipped.
-  HWY_INLINE Exit exit_edge(M m, int polygon, V ox, V oy, V dhx, V dhy) const {
-    const ivec4 poly = polygons_[polygon];
+  template <bool kOneRoom>
+  HWY_INLINE Exit exit_edge(M m, const Rooms& rooms, V ox, V oy, V dhx, V dhy) const {
     Exit x;
     x.s = Splat(kFar);
     x.edge = SplatI(-1);
     V u_exit = Splat(0.5f), tolerance_exit = Splat(0.0f);  // of the exit edge found so far
     const V vertex_tolerance = Splat(params_.vertex_tolerance);
-    for (int k = 0; k < poly.y; ++k) {
-      const EdgeRecord& e = edges_[poly.x + k];
-      const V nx = Splat(e.line.x), ny = Splat(e.line.y);
+    for (int k = 0; k < rooms.most_edges; ++k) {
+      const Slot at = slot<kOneRoom>(rooms, k);
+      const V nx = field<kOneRoom>(at, kNx);
+      const V ny = field<kOneRoom>(at, kNy);
       const V dn = dhx * nx + dhy * ny;
-      const M towards = hn::And(m, dn > Splat(0.0f));
+      const M towards = hn::And(hn::And(m, at.valid), dn > Splat(0.0f));
       if (!Any(towards)) continue;
-      const V s = (Splat(e.line.z) - (ox * nx + oy * ny)) / dn;
+      const V nz = field<kOneRoom>(at, kNa);
+      const V s = (nz - (ox * nx + oy * ny)) / dn;
       M ok = hn::AndNot(hn::Or(s < hn::Neg(vertex_tolerance), s >= x.s), towards);
       if (!Any(ok)) continue;  // no ray meets this edge's line before its exit so far
-      const float ax = e.segment.x, ay = e.segment.y;
-      const V u = (((ox + s * dhx) - Splat(ax)) * Splat(e.segment.z - ax) +
-                   ((oy + s * dhy) - Splat(ay)) * Splat(e.segment.w - ay)) *
-                  Splat(e.line.w);
-      const V tolerance = Splat(params_.vertex_tolerance * std::sqrt(e.line.w));
+      const V ax = field<kOneRoom>(at, kAx);
+      const V ay = field<kOneRoom>(at, kAy);
+      const V abx = field<kOneRoom>(at, kAbx);
+      const V aby = field<kOneRoom>(at, kAby);
+      const V w = field<kOneRoom>(at, kInvLength2);
+      const V u = (((ox + s * dhx) - ax) * abx + ((oy + s * dhy) - ay) * aby) * w;
+      const V tolerance = field<kOneRoom>(at, kTolerance);
       ok =
           hn::AndNot(hn::Or(hn::Lt(u, hn::Neg(tolerance)), hn::Gt(u, Splat(1.0f) + tolerance)), ok);
       x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
@@ -365,18 +481,19 @@ class Marcher {
     py = py - k * ny;
   }
 
-  // The rays of `m` (in `polygon`) at their edge `edge` go through it or are reflected, and are
+  // The rays of `m` at their edge `edge` (of their room) go through it or are reflected, and are
   // placed `push` inside the edge they are then behind. One broadcast record per edge.
-  HWY_INLINE void cross_edge(Packet& r, M m, int polygon, VI edge, V push) const {
-    const ivec4 poly = polygons_[polygon];
-    std::array<int32_t, hn::MaxLanes(DI())> lane_edges{};
+  HWY_INLINE void cross_edge(Packet& r, M m, VI edge, V push) const {
+    std::array<int32_t, hn::MaxLanes(DI())> lane_edges{}, lane_rooms{};
     hn::StoreU(edge, DI(), lane_edges.data());
-    // One round per edge the rays cross (usually one or two), not per edge of the polygon.
+    hn::StoreU(r.polygon, DI(), lane_rooms.data());
+    // One round per edge the rays cross (usually one or two), not per edge of their rooms.
     for (M left = m; Any(left);) {
-      const int k = lane_edges[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
-      const M mk = hn::And(left, Equal(edge, k));
+      const size_t first = static_cast<size_t>(hn::FindFirstTrue(D(), left));
+      const int k = lane_edges[first], polygon = lane_rooms[first];
+      const M mk = hn::And(left, hn::And(Equal(edge, k), Equal(r.polygon, polygon)));
       left = hn::AndNot(mk, left);
-      const EdgeRecord& e = edges_[poly.x + k];
+      const EdgeRecord& e = edges_[polygons_[polygon].x + k];
       V px = r.ox, py = r.oy;
       V hx = r.dx, hy = r.dy, hz = r.dz;
       if (has(kFeatureMirrors) && e.link.x == kEdgeMirror) {
@@ -418,13 +535,16 @@ class Marcher {
     r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
   }
 
-  // Which lanes' `edge` of `polygon` is an opaque wall.
-  HWY_INLINE M is_wall(int polygon, VI edge) const {
+  // Which lanes' `edge` of their room is an opaque wall.
+  HWY_INLINE M is_wall(const Rooms& rooms, VI edge) const {
     M wall = None();
     if (!has(kFeatureWalls)) return wall;
-    const ivec4 poly = polygons_[polygon];
-    for (int k = 0; k < poly.y; ++k)
-      if (edges_[poly.x + k].link.x == kEdgeWall) wall = hn::Or(wall, Equal(edge, k));
+    for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
+      const ivec4 poly = polygons_[rooms.polygon[i]];
+      for (int k = 0; k < poly.y; ++k)
+        if (edges_[poly.x + k].link.x == kEdgeWall)
+          wall = hn::Or(wall, hn::And(rooms.lanes[i], Equal(edge, k)));
+    }
     return wall;
   }
 
@@ -467,36 +587,40 @@ class Marcher {
     return hn::Max(box, Splat(o.shape.w) - hn::Sqrt(qx * qx + qy * qy + qz * qz));
   }
 
-  HWY_INLINE SolidDistance nearest_solid(int polygon, V px, V py, V pz) const {
+  HWY_INLINE SolidDistance nearest_solid(const Rooms& rooms, V px, V py, V pz) const {
     SolidDistance best;
     best.d = Splat(kFar);
     best.object = SplatI(-1);
     if (!has(kFeatureObjects)) return best;
-    const ivec4 poly = polygons_[polygon];
-    for (int k = poly.z; k < poly.z + poly.w; ++k) {
-      const V dk = solid_distance(k, px, py, pz);
-      const M nearer = dk < best.d;
-      best.d = Select(nearer, dk, best.d);
-      best.object = Select(nearer, SplatI(k), best.object);
+    for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
+      const ivec4 poly = polygons_[rooms.polygon[i]];
+      for (int k = poly.z; k < poly.z + poly.w; ++k) {
+        const V dk = solid_distance(k, px, py, pz);
+        const M nearer = hn::And(rooms.lanes[i], dk < best.d);
+        best.d = Select(nearer, dk, best.d);
+        best.object = Select(nearer, SplatI(k), best.object);
+      }
     }
     return best;
   }
 
   // Where a ray first comes within eps of a solid's bounding sphere in its room, or kFar.
-  HWY_INLINE V solid_entry(int polygon, const Packet& r) const {
-    const ivec4 poly = polygons_[polygon];
+  HWY_INLINE V solid_entry(const Rooms& rooms, const Packet& r) const {
     V first = Splat(kFar);
     M inside = None();
-    for (int k = poly.z; k < poly.z + poly.w; ++k) {
-      const glm::vec4 c = objects_[k].center;
-      const V ocx = r.ox - Splat(c.x), ocy = r.oy - Splat(c.y), ocz = r.oz - Splat(c.z);
-      const float radius = c.w + params_.eps;
-      const V b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
-      const V cc = (ocx * ocx + ocy * ocy + ocz * ocz) - Splat(radius * radius);
-      inside = hn::Or(inside, cc <= Splat(0.0f));
-      const V disc = b * b - cc;
-      const M ahead = hn::And(b < Splat(0.0f), disc >= Splat(0.0f));
-      first = Select(ahead, hn::Min(first, hn::Neg(b) - hn::Sqrt(disc)), first);
+    for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
+      const ivec4 poly = polygons_[rooms.polygon[i]];
+      for (int k = poly.z; k < poly.z + poly.w; ++k) {
+        const glm::vec4 c = objects_[k].center;
+        const V ocx = r.ox - Splat(c.x), ocy = r.oy - Splat(c.y), ocz = r.oz - Splat(c.z);
+        const float radius = c.w + params_.eps;
+        const V b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
+        const V cc = (ocx * ocx + ocy * ocy + ocz * ocz) - Splat(radius * radius);
+        inside = hn::Or(inside, hn::And(rooms.lanes[i], cc <= Splat(0.0f)));
+        const V disc = b * b - cc;
+        const M ahead = hn::And(rooms.lanes[i], hn::And(b < Splat(0.0f), disc >= Splat(0.0f)));
+        first = Select(ahead, hn::Min(first, hn::Neg(b) - hn::Sqrt(disc)), first);
+      }
     }
     return hn::IfThenZeroElse(inside, first);
   }
@@ -517,12 +641,14 @@ class Marcher {
     nz = gz * inv;
   }
 
-  // The rays of `m` hit their `object` of `polygon` where they are.
-  HWY_INLINE void hit_solid(Packet& r, M m, int polygon, VI object) const {
-    const ivec4 poly = polygons_[polygon];
-    for (int k = poly.z; k < poly.z + poly.w; ++k) {
-      const M mk = hn::And(m, Equal(object, k));
-      if (!Any(mk)) continue;
+  // The rays of `m` hit their `object` (an index in the object table) where they are.
+  HWY_INLINE void hit_solid(Packet& r, M m, VI object) const {
+    std::array<int32_t, hn::MaxLanes(DI())> lane_objects{};
+    hn::StoreU(object, DI(), lane_objects.data());
+    for (M left = m; Any(left);) {
+      const int k = lane_objects[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
+      const M mk = hn::And(left, Equal(object, k));
+      left = hn::AndNot(mk, left);
       V nx, ny, nz;
       solid_normal(k, r.ox, r.oy, r.oz, nx, ny, nz);
       r.nx = Select(mk, nx, r.nx);
@@ -546,10 +672,11 @@ class Marcher {
     x.last_step = hn::IfThenZeroElse(m, x.last_step);
   }
 
-  // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `polygon`.
-  HWY_INLINE void sphere_step(Packet& r, Relaxation& x, M m, int polygon) const {
-    const WallDistance wall = wall_distance(polygon, r.ox, r.oy);
-    const SolidDistance solid = nearest_solid(polygon, r.ox, r.oy, r.oz);
+  // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `rooms`.
+  template <bool kOneRoom>
+  HWY_INLINE void sphere_step(Packet& r, Relaxation& x, M m, const Rooms& rooms) const {
+    const WallDistance wall = wall_distance<kOneRoom>(rooms, r.ox, r.oy);
+    const SolidDistance solid = nearest_solid(rooms, r.ox, r.oy, r.oz);
     const V radius = hn::Min(wall.d, solid.d);
     // Over-relaxed steps whose unbounding spheres do not overlap are taken back.
     const M back = hn::And(hn::And(m, x.omega > Splat(1.0f)), radius + x.last_radius < x.last_step);
@@ -563,18 +690,18 @@ class Marcher {
     const V eps = Splat(params_.eps);
     const M hit = hn::And(rest, hn::And(solid.d < eps, solid.d <= wall_d));
     if (Any(hit)) {
-      hit_solid(r, hit, polygon, solid.object);
+      hit_solid(r, hit, solid.object);
       rest = hn::AndNot(hit, rest);
     }
     const M near = hn::And(rest, wall_d < eps);
     if (Any(near)) {
       const M corner = hn::And(near, wall.second < eps);
       finish(r, corner, SplatI(kHitVertex), kEventVertex, SplatI(-1), Splat(0.0f));
-      const M walls = hn::AndNot(corner, hn::And(near, is_wall(polygon, wall.edge)));
+      const M walls = hn::AndNot(corner, hn::And(near, is_wall(rooms, wall.edge)));
       finish(r, walls, SplatI(kHitWall), kEventWall, wall.edge, Splat(0.0f));
       const M cross = hn::AndNot(hn::Or(corner, walls), near);
       if (Any(cross)) {
-        cross_edge(r, cross, polygon, wall.edge, Splat(params_.offset));
+        cross_edge(r, cross, wall.edge, Splat(params_.offset));
         relax(x, cross);
       }
       rest = hn::AndNot(near, rest);
@@ -602,16 +729,17 @@ class Marcher {
     seg.solids = Select(m, hn::Max(seg.solids - s, Splat(0.0f)), seg.solids);
   }
 
-  // One iteration of the analytic method for the rays of `m`, in `polygon`.
-  HWY_INLINE void analytic_step(Packet& r, Segment& seg, M m, int polygon) const {
+  // One iteration of the analytic method for the rays of `m`, in `rooms`.
+  template <bool kOneRoom>
+  HWY_INLINE void analytic_step(Packet& r, Segment& seg, M m, const Rooms& rooms) const {
     const M unknown = hn::AndNot(seg.known, m);
     if (Any(unknown)) {
-      const Exit x = exit_edge(unknown, polygon, r.ox, r.oy, r.dx, r.dy);
+      const Exit x = exit_edge<kOneRoom>(unknown, rooms, r.ox, r.oy, r.dx, r.dy);
       seg.exit.s = Select(unknown, x.s, seg.exit.s);
       seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
       seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
       if (has(kFeatureObjects))
-        seg.solids = Select(unknown, solid_entry(polygon, r), seg.solids);
+        seg.solids = Select(unknown, solid_entry(rooms, r), seg.solids);
       else
         seg.solids = Select(unknown, Splat(kFar), seg.solids);
       seg.known = hn::Or(seg.known, unknown);
@@ -625,9 +753,9 @@ class Marcher {
       if (Any(solids)) {
         move_in_segment(r, seg, solids, seg.solids);
         band = Select(solids, band_exit(r.oz, r.dz), band);
-        const SolidDistance solid = nearest_solid(polygon, r.ox, r.oy, r.oz);
+        const SolidDistance solid = nearest_solid(rooms, r.ox, r.oy, r.oz);
         const M hit = hn::And(solids, solid.d < Splat(params_.eps));
-        hit_solid(r, hit, polygon, solid.object);
+        hit_solid(r, hit, solid.object);
         const M on = hn::AndNot(hit, solids);
         remaining = Select(on, max_distance - r.t, remaining);
         const M step = hn::And(on, solid.d < hn::Min(hn::Min(seg.exit.s, band), remaining));
@@ -649,12 +777,12 @@ class Marcher {
     finish(r, vertex, SplatI(kHitVertex), kEventVertex, SplatI(-1),
            hn::IfThenZeroElse(no_edge, seg.exit.s));
     rest = hn::AndNot(vertex, rest);
-    const M wall = hn::And(rest, is_wall(polygon, seg.exit.edge));
+    const M wall = hn::And(rest, is_wall(rooms, seg.exit.edge));
     finish(r, wall, SplatI(kHitWall), kEventWall, seg.exit.edge, seg.exit.s);
     rest = hn::AndNot(wall, rest);
     if (Any(rest)) {
       advance(r, rest, seg.exit.s);
-      cross_edge(r, rest, polygon, seg.exit.edge, Splat(0.0f));
+      cross_edge(r, rest, seg.exit.edge, Splat(0.0f));
       seg.known = hn::AndNot(rest, seg.known);
     }
   }
@@ -696,6 +824,9 @@ class Marcher {
 
   const ivec4* polygons_;
   const EdgeRecord* edges_;
+  const glm::vec4* extra_;  // per edge: b - a (x, y), vertex tolerance in u (z), a.y + (b - a).y
+  bool merge_ = false;      // whether a pass may span several rooms
+  std::array<std::array<float, hn::MaxLanes(D())>, kFields> lookup_{};  // [field][edge]
   const ObjectRecord* objects_;
   KernelParams params_;
   uint features_;
@@ -718,7 +849,7 @@ int PacketLanes() {
 constexpr size_t kRefillAt = FLATMARCH_REFILL_AT;  // eighths of the lanes
 void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
   const TileShape tile = tile_shape(PacketLanes());
-  const Marcher marcher(*job.tables, nullptr, 0);
+  const Marcher marcher(*job.tables, job.edge_extra, nullptr, 0);
   const CameraBasis<float>& c = job.basis;
   const DI di;
   constexpr size_t kMax = hn::MaxLanes(DI());
@@ -814,7 +945,7 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
 // its steps.
 int TraceRay(const PacketJob& job, const Ray& ray, int max_events,
              std::vector<kernel::KernelEvent>* events) {
-  const Marcher marcher(*job.tables, events, max_events);
+  const Marcher marcher(*job.tables, job.edge_extra, events, max_events);
   Packet r;
   Relaxation x;
   Segment seg;
@@ -835,6 +966,17 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace flatmarch::simd {
+
+PacketJob packet_job(const kernel::SceneTables<float>& tables) {
+  PacketJob job;
+  job.tables = &tables;
+  for (const auto& e : tables.edges) {
+    const float abx = e.segment.z - e.segment.x, aby = e.segment.w - e.segment.y;
+    job.edge_extra.emplace_back(abx, aby, tables.params.vertex_tolerance * std::sqrt(e.line.w),
+                                e.segment.y + aby);
+  }
+  return job;
+}
 
 HWY_EXPORT(PacketLanes);
 HWY_EXPORT(MarchPackets);

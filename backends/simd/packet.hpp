@@ -19,6 +19,9 @@ struct LaneCounts {
 
 struct PacketJob {
   const kernel::SceneTables<float>* tables = nullptr;
+  // Per edge of tables->edges, what the packets would otherwise recompute per step: b - a (x, y),
+  // the vertex tolerance in units of the edge parameter (z), a.y + (b - a).y (w).
+  std::vector<glm::vec4> edge_extra;
   // transmittance[c] = (1 - wall_tint)^c for c crossings, c <= max_steps, as the kernel's
   // shade computes it.
   std::vector<float> transmittance;
@@ -30,6 +33,9 @@ struct PacketJob {
   int width = 0, height = 0;
   Frame* frame = nullptr;
 };
+
+// A job on `tables` with its edge_extra filled in (no frame).
+PacketJob packet_job(const kernel::SceneTables<float>& tables);
 
 // The tile of pixels one packet covers, for a vector of `lanes` lanes: as square as it can be.
 struct TileShape {

@@ -97,8 +97,7 @@ void check_precision(const MarchParams& params) {
 // The job of a frame: the compiled scene, the camera and the colour table.
 simd::PacketJob frame_job(const kernel::SceneTables<float>& tables, const Camera& camera, int width,
                           int height, Frame& frame) {
-  simd::PacketJob job;
-  job.tables = &tables;
+  simd::PacketJob job = simd::packet_job(tables);
   // As the kernel's shade computes it, in f32.
   const int size = std::min(tables.params.max_steps, simd::kTransmittanceTable) + 1;
   const float clear = 1.0f - tables.params.wall_tint;
@@ -169,8 +168,7 @@ Trace SimdBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& 
   check_precision(params);
   const simd::PacketCode packets = code();
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
-  simd::PacketJob job;
-  job.tables = &tables;
+  const simd::PacketJob job = simd::packet_job(tables);
   std::vector<kernel::KernelEvent> events;
   const int steps = packets.trace(job, ray, max_events, &events);
   return kernel_trace(events, steps);
