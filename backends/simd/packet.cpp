@@ -468,9 +468,9 @@ class Marcher {
   }
 
   HWY_INLINE V band_exit(V oz, V dz) const {
-    const V up = (Splat(params_.top) - oz) / dz;
-    const V down = hn::Neg(oz) / dz;
-    return Select(dz > Splat(0.0f), up, Select(dz < Splat(0.0f), down, Splat(kFar)));
+    const M up = dz > Splat(0.0f);
+    const V s = Select(up, Splat(params_.top) - oz, hn::Neg(oz)) / dz;  // one division for both
+    return Select(up, s, Select(dz < Splat(0.0f), s, Splat(kFar)));
   }
 
   // Moves p along the normal of an edge's line so that it lies `inside` within it.
