@@ -57,6 +57,7 @@ void scalar_frame(benchmark::State& state, const Scene* scene, MarchParams param
 
 int main(int argc, char** argv) {
   using namespace flatmarch;
+  bench::keep_freed_frames();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
 
