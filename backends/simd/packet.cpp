@@ -110,10 +110,11 @@ struct Segment {
 };
 
 // The rooms of one pass: the polygons its rays are in (at most kRoomsPerPass) and the lanes in
-// each. A table read gives every lane its own room's record: a broadcast of the first room's,
-// blended with the others'. Coherent rays are mostly in one room, where a read is a broadcast;
-// rays split between a few rooms (the double pentagon's two, at every crossing) still take one
-// pass a step, not one per room.
+// each. A table read gives every lane its own room's record: in one room a broadcast, in several
+// a lookup of each lane's edge in vectors holding the scene's edges (Marcher::lookup_; scenes
+// whose edges do not fit in a vector take one room a pass). Coherent rays are mostly in one room;
+// rays split between a few (the double pentagon's two, at every crossing) still take one pass a
+// step, not one per room.
 constexpr int kRoomsPerPass = 4;
 struct Rooms {
   int count = 0;
@@ -173,6 +174,31 @@ class Marcher {
     for (size_t f = 0; f < kFields; ++f)
       for (size_t e = 0; e < tables.edges.size(); ++e)
         lookup_[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], edge_extra[e]);
+    // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
+    for (size_t p = 0; p < tables.polygons.size(); ++p) first_edge_[p] = tables.polygons[p].x;
+    for (size_t e = 0; e < tables.edges.size(); ++e) {
+      const EdgeRecord& edge = tables.edges[e];
+      const ivec4 link = edge.link;
+      const glm::vec4 to = link.x == kEdgeGlued
+                               ? tables
+                                     .edges[static_cast<size_t>(
+                                         tables.polygons[static_cast<size_t>(link.y)].x + link.z)]
+                                     .line
+                               : glm::vec4(0.0f);
+      const std::array<float, kGlueFields> glue{edge.map_shift.x,
+                                                edge.map_shift.y,
+                                                edge.map_linear.x,
+                                                edge.map_linear.y,
+                                                edge.map_linear.z,
+                                                edge.map_linear.w,
+                                                to.x,
+                                                to.y,
+                                                to.z};
+      for (size_t f = 0; f < kGlueFields; ++f) glue_[f][e] = glue[f];
+      to_polygon_[e] = link.x == kEdgeGlued ? link.y : 0;
+      if (link.x == kEdgeGlued && edge.map_linear != glm::vec4(1.0f, 0.0f, 0.0f, 1.0f))
+        translations_ = false;
+    }
   }
 
   // A packet with no rays: every lane done.
@@ -484,6 +510,10 @@ class Marcher {
   // The rays of `m` at their edge `edge` (of their room) go through it or are reflected, and are
   // placed `push` inside the edge they are then behind. One broadcast record per edge.
   HWY_INLINE void cross_edge(Packet& r, M m, VI edge, V push) const {
+    if (merge_ && !has(kFeatureMirrors)) {
+      cross_glued(r, m, edge, push);
+      return;
+    }
     std::array<int32_t, hn::MaxLanes(DI())> lane_edges{}, lane_rooms{};
     hn::StoreU(edge, DI(), lane_edges.data());
     hn::StoreU(r.polygon, DI(), lane_rooms.data());
@@ -532,6 +562,52 @@ class Marcher {
       r.dy = Select(mk, hy, r.dy);
       r.dz = Select(mk, hz, r.dz);
     }
+    r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
+  }
+
+  // cross_edge when every edge the rays cross is glued and the scene's edges fit in a vector:
+  // each lane looks its edge's gluing up (glue_), all in one round.
+  HWY_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
+    const DI di;
+    if (events_ && !hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1)))) {
+      const ivec4 link = edges_[polygons_[hn::GetLane(r.polygon)].x + hn::GetLane(edge)].link;
+      record(m, kEventGluing, r.polygon, edge, link.y, link.z, SplatI(-1), r);
+    }
+    const VI first = hn::TableLookupLanes(hn::LoadU(di, first_edge_.data()),
+                                          hn::IndicesFromVec(di, Select(m, r.polygon, SplatI(0))));
+    const auto at = hn::IndicesFromVec(D(), Select(m, first + edge, SplatI(0)));
+    const auto glue = [&](size_t f) HWY_ATTR {
+      return hn::TableLookupLanes(hn::LoadU(D(), glue_[f].data()), at);
+    };
+    V px, py, hx = r.dx, hy = r.dy, hz = r.dz;
+    if (translations_) {
+      px = r.ox + glue(0);
+      py = r.oy + glue(1);
+    } else {
+      const V mx = glue(2), my = glue(3), mz = glue(4), mw = glue(5);
+      px = (mx * r.ox + mz * r.oy) + glue(0);
+      py = (my * r.ox + mw * r.oy) + glue(1);
+      hx = mx * r.dx + mz * r.dy;
+      hy = my * r.dx + mw * r.dy;
+    }
+    const V nx = glue(6), ny = glue(7);
+    const V k = ((px * nx + py * ny) - glue(8)) + push;  // place
+    px = px - k * nx;
+    py = py - k * ny;
+    if (has(kFeatureScaled)) {  // normalize
+      const V inv = Splat(1.0f) / hn::Sqrt(hx * hx + hy * hy + hz * hz);
+      hx = hx * inv;
+      hy = hy * inv;
+      hz = hz * inv;
+    }
+    const VI to = hn::TableLookupLanes(hn::LoadU(di, to_polygon_.data()),
+                                       hn::IndicesFromVec(di, Select(m, first + edge, SplatI(0))));
+    r.polygon = Select(m, to, r.polygon);
+    r.ox = Select(m, px, r.ox);
+    r.oy = Select(m, py, r.oy);
+    r.dx = Select(m, hx, r.dx);
+    r.dy = Select(m, hy, r.dy);
+    r.dz = Select(m, hz, r.dz);
     r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
   }
 
@@ -827,6 +903,12 @@ class Marcher {
   const glm::vec4* extra_;  // per edge: b - a (x, y), vertex tolerance in u (z), a.y + (b - a).y
   bool merge_ = false;      // whether a pass may span several rooms
   std::array<std::array<float, hn::MaxLanes(D())>, kFields> lookup_{};  // [field][edge]
+  // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
+  // (3); the destination polygon; and whether every gluing is a translation.
+  static constexpr size_t kGlueFields = 9;
+  std::array<std::array<float, hn::MaxLanes(D())>, kGlueFields> glue_{};
+  std::array<int32_t, hn::MaxLanes(DI())> to_polygon_{}, first_edge_{};
+  bool translations_ = true;
   const ObjectRecord* objects_;
   KernelParams params_;
   uint features_;
@@ -839,14 +921,15 @@ int PacketLanes() {
   return static_cast<int>(hn::Lanes(D()));
 }
 
-// Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
-// grid of tiles and writes them. The lanes of one packet take the chunk's pixels tile by tile,
-// and a lane whose ray has ended takes the next pixel at once, so that a few long rays do not
-// hold up the rest of their tile (lanes stay busy until the chunk's pixels run out).
 // Lanes wait for a new pixel until this many eighths of them do: refilling costs a shading and a
 // camera ray for the whole packet, and waiting lanes idle. 2/8 measured best on the L-shape
 // (utilisation 0.95 against 0.87 at 4/8; 1/8 spends more on refills than it gains).
 constexpr size_t kRefillAt = 2;
+
+// Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
+// grid of tiles and writes them. The lanes of one packet take the chunk's pixels tile by tile,
+// and a lane whose ray has ended takes a next pixel soon (kRefillAt), so that a few long rays do
+// not hold up the rest of their tile (lanes stay busy until the chunk's pixels run out).
 void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
   const TileShape tile = tile_shape(PacketLanes());
   const Marcher marcher(*job.tables, job.edge_extra, nullptr, 0);
@@ -874,8 +957,7 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   const int64_t bound = queue * (int64_t{job.tables->params.max_steps} + 1) + 1;
   M occupied = None();  // lanes holding a pixel
   for (int64_t iteration = 0; iteration < bound; ++iteration) {
-    // Lanes are refilled once enough of them wait (each refill costs a shading and a camera
-    // ray for the whole packet), or when none is left marching.
+    // Lanes are refilled once enough of them wait, or when none is left marching.
     const M waiting = next < queue ? r.done : hn::And(r.done, occupied);
     const size_t count = hn::CountTrue(D(), waiting);
     bool refill = false;
