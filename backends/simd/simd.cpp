@@ -20,8 +20,8 @@ namespace simd {
 namespace {
 
 // --isa names of the Highway targets packet.cpp may be compiled for, best first.
-constexpr std::array<std::pair<const char*, int64_t>, 4> kIsas{
-    {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4}, {"emu128", HWY_EMU128}}};
+constexpr std::array<std::pair<const char*, int64_t>, 3> kIsas{
+    {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4}}};
 
 // Entries of the transmittance table (per crossing count); rays with more crossings are rare
 // and shaded one by one.
@@ -43,8 +43,12 @@ SimdBackend::SimdBackend(BackendOptions options) : options_(std::move(options)) 
   const std::vector<std::string> supported = simd::isa_names(true);
   if (options_.threads < 0) {
     unavailable_ = "--threads must be 0 (all cores) or more";
+  } else if (supported.empty()) {
+    unavailable_ =
+        "this CPU runs none of the instruction sets it was compiled for (avx512, avx2, "
+        "sse4)";
   } else if (options_.isa.empty()) {
-    isa_ = supported.front();  // emu128 is always there
+    isa_ = supported.front();
   } else if (std::find(supported.begin(), supported.end(), options_.isa) != supported.end()) {
     isa_ = options_.isa;
   } else {
@@ -58,6 +62,8 @@ SimdBackend::SimdBackend(BackendOptions options) : options_(std::move(options)) 
   }
   for (const auto& [name, target] : simd::kIsas)
     if (isa_ == name) target_ = target;
+  // The best target needs no forcing.
+  if (target_ != 0) code_ = simd::packet_code(isa_ == supported.front() ? 0 : target_);
 }
 
 std::string SimdBackend::description() const {
@@ -77,13 +83,11 @@ Availability SimdBackend::availability() const {
 
 simd::PacketCode SimdBackend::code() const {
   if (target_ == 0) throw std::runtime_error("the simd backend is unavailable: " + unavailable_);
-  // The best target needs no forcing; forcing it anyway would serialise renders on a mutex.
-  const bool best = isa_ == simd::isa_names(true).front();
-  return simd::packet_code(best ? 0 : target_);
+  return code_;
 }
 
 int SimdBackend::lanes() const {
-  return target_ == 0 ? 0 : code().lanes();
+  return target_ == 0 ? 0 : code_.lanes();
 }
 
 namespace {

@@ -47,7 +47,8 @@ class SimdBackend final : public Backend {
   simd::PacketCode code() const;
 
   BackendOptions options_;
-  int64_t target_ = 0;  // the Highway target; 0 when options_.isa cannot run here
+  int64_t target_ = 0;       // the Highway target; 0 when options_.isa cannot run here
+  simd::PacketCode code_{};  // its entry points
   std::string isa_, unavailable_;
 };
 
