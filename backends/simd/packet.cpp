@@ -26,6 +26,16 @@
 
 #include "backends/simd/packet.hpp"
 
+// The marcher's functions are inlined into one loop, but under the sanitizers GCC then takes
+// over ten minutes on that one function: there it decides what to inline.
+#ifndef FLATMARCH_PACKET_INLINE
+#ifdef FLATMARCH_SANITIZE_BUILD
+#define FLATMARCH_PACKET_INLINE inline
+#else
+#define FLATMARCH_PACKET_INLINE HWY_INLINE
+#endif
+#endif
+
 HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
@@ -215,7 +225,7 @@ class Marcher {
 
   // The start of march.glsl's march(): the lanes of `m` begin a ray from (fx, fy, fz) in
   // `polygon` along (dx, dy, dz). The other lanes are left as they are.
-  HWY_INLINE void start(Packet& r, Relaxation& x, Segment& seg, M m, int polygon, V fx, V fy, V fz,
+  FLATMARCH_PACKET_INLINE void start(Packet& r, Relaxation& x, Segment& seg, M m, int polygon, V fx, V fy, V fz,
                         V dx, V dy, V dz) const {
     r.polygon = Select(m, SplatI(polygon), r.polygon);
     r.ox = Select(m, fx, r.ox);
@@ -250,7 +260,7 @@ class Marcher {
   // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
   // of the rays that have taken max_steps. A step runs in passes of up to kRoomsPerPass rooms
   // (usually one pass); the rays a pass moves to another room are already out of `pending`.
-  HWY_INLINE void step(Packet& r, Relaxation& x, Segment& seg, LaneCounts& lanes) const {
+  FLATMARCH_PACKET_INLINE void step(Packet& r, Relaxation& x, Segment& seg, LaneCounts& lanes) const {
     const M active = hn::Not(r.done);
     r.steps = Select(active, r.steps + SplatI(1), r.steps);
     std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
@@ -293,7 +303,7 @@ class Marcher {
 
   // march.glsl's shade(): the linear colour of finished rays. transmittance[c] is
   // (1 - wall_tint)^c as shade computes it, for the first crossing counts.
-  HWY_INLINE void shade(const Packet& r, const std::vector<float>& transmittance, V& red, V& green,
+  FLATMARCH_PACKET_INLINE void shade(const Packet& r, const std::vector<float>& transmittance, V& red, V& green,
                         V& blue) const {
     V cr = Splat(params_.background.x), cg = Splat(params_.background.y);
     V cb = Splat(params_.background.z);
@@ -342,7 +352,7 @@ class Marcher {
   bool has(uint feature) const { return (features_ & feature) != 0u; }
 
   // Records an event of lane 0 (the one a trace follows) when it is in `m`.
-  HWY_INLINE void record(M m, int kind, VI polygon, VI edge, int to_polygon, int to_edge, VI hit,
+  FLATMARCH_PACKET_INLINE void record(M m, int kind, VI polygon, VI edge, int to_polygon, int to_edge, VI hit,
                          const Packet& r) const {
     if (!events_ || static_cast<int>(events_->size()) >= max_events_ ||
         hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1))))
@@ -353,7 +363,7 @@ class Marcher {
                         glm::dvec3(hn::GetLane(r.ox), hn::GetLane(r.oy), hn::GetLane(r.oz))});
   }
 
-  HWY_INLINE static void advance(Packet& r, M m, V s) {
+  static FLATMARCH_PACKET_INLINE void advance(Packet& r, M m, V s) {
     r.ox = Select(m, r.ox + s * r.dx, r.ox);
     r.oy = Select(m, r.oy + s * r.dy, r.oy);
     r.oz = Select(m, r.oz + s * r.dz, r.oz);
@@ -361,7 +371,7 @@ class Marcher {
   }
 
   // Ends the rays of `m` `s` further on.
-  HWY_INLINE void finish(Packet& r, M m, VI hit, int event, VI edge, V s) const {
+  FLATMARCH_PACKET_INLINE void finish(Packet& r, M m, VI hit, int event, VI edge, V s) const {
     if (!Any(m)) return;
     advance(r, m, s);
     r.hit = Select(m, hit, r.hit);
@@ -379,7 +389,7 @@ class Marcher {
     M valid;
   };
   template <bool kOneRoom>
-  HWY_INLINE Slot slot(const Rooms& rooms, int k) const {
+  FLATMARCH_PACKET_INLINE Slot slot(const Rooms& rooms, int k) const {
     Slot at;
     if constexpr (kOneRoom) {
       at.edge = polygons_[rooms.polygon[0]].x + k;
@@ -395,7 +405,7 @@ class Marcher {
   // Number `f` of each lane's edge in `at`: in one room a broadcast, in several a lookup in
   // the scene's edge numbers held in vectors (lookup_).
   template <bool kOneRoom>
-  HWY_INLINE V field(const Slot& at, Field f) const {
+  FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
     if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
     return hn::TableLookupLanes(hn::LoadU(D(), lookup_[f].data()),
                                 hn::IndicesFromVec(D(), at.edges));
@@ -403,7 +413,7 @@ class Marcher {
 
   // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a,
   // ay_aby = a.y + ab.y.
-  HWY_INLINE static M crosses(V ay, V ay_aby, V abx, V aby, V py, V apx, V apy) {
+  static FLATMARCH_PACKET_INLINE M crosses(V ay, V ay_aby, V abx, V aby, V py, V apx, V apy) {
     const M over_a = py >= ay;
     const M under_b = py < ay_aby;
     const M left = abx * apy > aby * apx;
@@ -411,7 +421,7 @@ class Marcher {
                   hn::Not(hn::Or(hn::Or(over_a, under_b), left)));
   }
 
-  HWY_INLINE M inside_polygon(int polygon, V px, V py) const {
+  FLATMARCH_PACKET_INLINE M inside_polygon(int polygon, V px, V py) const {
     const ivec4 poly = polygons_[polygon];
     M inside = None();
     for (int k = poly.x; k < poly.x + poly.y; ++k) {
@@ -425,7 +435,7 @@ class Marcher {
   }
 
   template <bool kOneRoom>
-  HWY_INLINE WallDistance wall_distance(const Rooms& rooms, V px, V py) const {
+  FLATMARCH_PACKET_INLINE WallDistance wall_distance(const Rooms& rooms, V px, V py) const {
     V best = Splat(kFar), second = Splat(kFar);
     VI edge = SplatI(-1);
     M inside = None();
@@ -458,7 +468,7 @@ class Marcher {
 
   // For the rays of `m`; an edge none of them moves towards is skipped.
   template <bool kOneRoom>
-  HWY_INLINE Exit exit_edge(M m, const Rooms& rooms, V ox, V oy, V dhx, V dhy) const {
+  FLATMARCH_PACKET_INLINE Exit exit_edge(M m, const Rooms& rooms, V ox, V oy, V dhx, V dhy) const {
     Exit x;
     x.s = Splat(kFar);
     x.edge = SplatI(-1);
@@ -493,14 +503,14 @@ class Marcher {
     return x;
   }
 
-  HWY_INLINE V band_exit(V oz, V dz) const {
+  FLATMARCH_PACKET_INLINE V band_exit(V oz, V dz) const {
     const M up = dz > Splat(0.0f);
     const V s = Select(up, Splat(params_.top) - oz, hn::Neg(oz)) / dz;  // one division for both
     return Select(up, s, Select(dz < Splat(0.0f), s, Splat(kFar)));
   }
 
   // Moves p along the normal of an edge's line so that it lies `inside` within it.
-  HWY_INLINE static void place(V& px, V& py, const glm::vec4& line, V inside) {
+  static FLATMARCH_PACKET_INLINE void place(V& px, V& py, const glm::vec4& line, V inside) {
     const V nx = Splat(line.x), ny = Splat(line.y);
     const V k = ((px * nx + py * ny) - Splat(line.z)) + inside;
     px = px - k * nx;
@@ -509,7 +519,7 @@ class Marcher {
 
   // The rays of `m` at their edge `edge` (of their room) go through it or are reflected, and are
   // placed `push` inside the edge they are then behind. One broadcast record per edge.
-  HWY_INLINE void cross_edge(Packet& r, M m, VI edge, V push) const {
+  FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, VI edge, V push) const {
     if (merge_ && !has(kFeatureMirrors)) {
       cross_glued(r, m, edge, push);
       return;
@@ -567,7 +577,7 @@ class Marcher {
 
   // cross_edge when every edge the rays cross is glued and the scene's edges fit in a vector:
   // each lane looks its edge's gluing up (glue_), all in one round.
-  HWY_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
+  FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
     const DI di;
     if (events_ && !hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1)))) {
       const ivec4 link = edges_[polygons_[hn::GetLane(r.polygon)].x + hn::GetLane(edge)].link;
@@ -612,7 +622,7 @@ class Marcher {
   }
 
   // Which lanes' `edge` of their room is an opaque wall.
-  HWY_INLINE M is_wall(const Rooms& rooms, VI edge) const {
+  FLATMARCH_PACKET_INLINE M is_wall(const Rooms& rooms, VI edge) const {
     M wall = None();
     if (!has(kFeatureWalls)) return wall;
     for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
@@ -625,7 +635,7 @@ class Marcher {
   }
 
   // The rays of `m` reach the top or bottom of the band, `s` further on.
-  HWY_INLINE void leave_band(Packet& r, M m, V s) const {
+  FLATMARCH_PACKET_INLINE void leave_band(Packet& r, M m, V s) const {
     if (has(kFeaturePeriod)) {
       advance(r, m, s);
       r.oz = Select(m, Select(r.dz > Splat(0.0f), Splat(0.0f), Splat(params_.top)), r.oz);
@@ -641,7 +651,7 @@ class Marcher {
 
   // ---- Solids --------------------------------------------------------------------------------
 
-  HWY_INLINE V solid_distance(int k, V px, V py, V pz) const {
+  FLATMARCH_PACKET_INLINE V solid_distance(int k, V px, V py, V pz) const {
     const ObjectRecord& o = objects_[k];
     const V qx = px - Splat(o.center.x), qy = py - Splat(o.center.y);
     const V qz = pz - Splat(o.center.z);
@@ -663,7 +673,7 @@ class Marcher {
     return hn::Max(box, Splat(o.shape.w) - hn::Sqrt(qx * qx + qy * qy + qz * qz));
   }
 
-  HWY_INLINE SolidDistance nearest_solid(const Rooms& rooms, V px, V py, V pz) const {
+  FLATMARCH_PACKET_INLINE SolidDistance nearest_solid(const Rooms& rooms, V px, V py, V pz) const {
     SolidDistance best;
     best.d = Splat(kFar);
     best.object = SplatI(-1);
@@ -681,7 +691,7 @@ class Marcher {
   }
 
   // Where a ray first comes within eps of a solid's bounding sphere in its room, or kFar.
-  HWY_INLINE V solid_entry(const Rooms& rooms, const Packet& r) const {
+  FLATMARCH_PACKET_INLINE V solid_entry(const Rooms& rooms, const Packet& r) const {
     V first = Splat(kFar);
     M inside = None();
     for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
@@ -702,7 +712,7 @@ class Marcher {
   }
 
   // The gradient of solid k's distance at p by central differences on a tetrahedron.
-  HWY_INLINE void solid_normal(int k, V px, V py, V pz, V& nx, V& ny, V& nz) const {
+  FLATMARCH_PACKET_INLINE void solid_normal(int k, V px, V py, V pz, V& nx, V& ny, V& nz) const {
     const V h = Splat(params_.normal_step);
     const V s1 = solid_distance(k, px + h, py - h, pz - h);  // (1, -1, -1)
     const V s2 = solid_distance(k, px - h, py - h, pz + h);  // (-1, -1, 1)
@@ -718,7 +728,7 @@ class Marcher {
   }
 
   // The rays of `m` hit their `object` (an index in the object table) where they are.
-  HWY_INLINE void hit_solid(Packet& r, M m, VI object) const {
+  FLATMARCH_PACKET_INLINE void hit_solid(Packet& r, M m, VI object) const {
     std::array<int32_t, hn::MaxLanes(DI())> lane_objects{};
     hn::StoreU(object, DI(), lane_objects.data());
     for (M left = m; Any(left);) {
@@ -741,7 +751,7 @@ class Marcher {
 
   // ---- Methods -------------------------------------------------------------------------------
 
-  HWY_INLINE void relax(Relaxation& x, M m) const {
+  FLATMARCH_PACKET_INLINE void relax(Relaxation& x, M m) const {
     const V omega = Splat(params_.method == kMethodRelaxed ? params_.omega : 1.0f);
     x.omega = Select(m, omega, x.omega);
     x.last_radius = hn::IfThenZeroElse(m, x.last_radius);
@@ -750,7 +760,7 @@ class Marcher {
 
   // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `rooms`.
   template <bool kOneRoom>
-  HWY_INLINE void sphere_step(Packet& r, Relaxation& x, M m, const Rooms& rooms) const {
+  FLATMARCH_PACKET_INLINE void sphere_step(Packet& r, Relaxation& x, M m, const Rooms& rooms) const {
     const WallDistance wall = wall_distance<kOneRoom>(rooms, r.ox, r.oy);
     const SolidDistance solid = nearest_solid(rooms, r.ox, r.oy, r.oz);
     const V radius = hn::Min(wall.d, solid.d);
@@ -799,7 +809,7 @@ class Marcher {
     advance(r, rest, x.last_step);
   }
 
-  HWY_INLINE static void move_in_segment(Packet& r, Segment& seg, M m, V s) {
+  static FLATMARCH_PACKET_INLINE void move_in_segment(Packet& r, Segment& seg, M m, V s) {
     advance(r, m, s);
     seg.exit.s = Select(m, seg.exit.s - s, seg.exit.s);
     seg.solids = Select(m, hn::Max(seg.solids - s, Splat(0.0f)), seg.solids);
@@ -807,7 +817,7 @@ class Marcher {
 
   // One iteration of the analytic method for the rays of `m`, in `rooms`.
   template <bool kOneRoom>
-  HWY_INLINE void analytic_step(Packet& r, Segment& seg, M m, const Rooms& rooms) const {
+  FLATMARCH_PACKET_INLINE void analytic_step(Packet& r, Segment& seg, M m, const Rooms& rooms) const {
     const M unknown = hn::AndNot(seg.known, m);
     if (Any(unknown)) {
       const Exit x = exit_edge<kOneRoom>(unknown, rooms, r.ox, r.oy, r.dx, r.dy);
@@ -866,7 +876,7 @@ class Marcher {
   // ---- A whole ray ---------------------------------------------------------------------------
 
   // The rays of `m`, outside the band, enter the first polygon whose footprint they cross.
-  HWY_INLINE void enter_band(Packet& r, M m) const {
+  FLATMARCH_PACKET_INLINE void enter_band(Packet& r, M m) const {
     if (!Any(m)) return;
     const V height = Splat(params_.height), max_distance = Splat(params_.max_distance);
     const M above = r.oz > height;
