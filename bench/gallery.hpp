@@ -24,6 +24,14 @@ inline void keep_freed_frames() {
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
 }
 
+// What a benchmark program does first: keep freed frames and take Google Benchmark's flags.
+// False when a flag is unknown (it has been reported; exit with 2).
+inline bool begin(int& argc, char** argv) {
+  keep_freed_frames();
+  benchmark::Initialize(&argc, argv);
+  return !benchmark::ReportUnrecognizedArguments(argc, argv);
+}
+
 // The gallery scenes (scenes/*.json), sorted by file name; pointers stay valid for benchmarks.
 inline std::vector<std::unique_ptr<Scene>> load_gallery() {
   std::vector<std::filesystem::path> files;

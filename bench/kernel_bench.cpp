@@ -65,9 +65,7 @@ void extra_features(benchmark::State& state, const Scene* scene, Method method, 
 
 int main(int argc, char** argv) {
   using namespace flatmarch;
-  bench::keep_freed_frames();
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+  if (!bench::begin(argc, argv)) return 2;
 
   const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
 

@@ -57,9 +57,7 @@ void scalar_frame(benchmark::State& state, const Scene* scene, MarchParams param
 
 int main(int argc, char** argv) {
   using namespace flatmarch;
-  bench::keep_freed_frames();
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+  if (!bench::begin(argc, argv)) return 2;
 
   const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
   const std::vector<std::string> isas = simd::isa_names(true);
