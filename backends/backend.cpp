@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "backends/kernel_trace.hpp"
+#include "backends/opengl/opengl.hpp"
 #include "backends/oracle/oracle.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/simd.hpp"
@@ -82,13 +83,14 @@ Trace kernel_trace(const std::vector<kernel::KernelEvent>& events, int steps) {
 }
 
 namespace {
-constexpr std::array<const char*, 3> kBackendNames{"oracle", "scalar", "simd"};
+constexpr std::array<const char*, 4> kBackendNames{"oracle", "scalar", "simd", "opengl"};
 }  // namespace
 
 std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOptions& options) {
   if (name == "oracle") return std::make_unique<OracleBackend>();
   if (name == "scalar") return std::make_unique<ScalarBackend>();
   if (name == "simd") return std::make_unique<SimdBackend>(options);
+  if (name == "opengl") return std::make_unique<OpenGlBackend>();
   return nullptr;
 }
 

@@ -12,5 +12,6 @@ void add_backends(CLI::App& app);
 void add_gallery(CLI::App& app);
 void add_plan(CLI::App& app);
 void add_import_peer(CLI::App& app);
+void add_shader(CLI::App& app);
 
 }  // namespace flatmarch::cli

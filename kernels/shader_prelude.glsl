@@ -1,12 +1,34 @@
-// The GLSL side of the kernel's subset (see kernels/glsl.hpp) and the bindings of the compiled
-// scene's tables; shader_source() puts it between the tables' definitions and the kernel.
+// The GLSL side of the kernel's subset (see kernels/glsl.hpp): shader_source() puts it between
+// the tables (as buffers 0-2, or baked in as constants) and the kernel. The parameters are
+// uniform block 3, so that eps, offset and the method change without recompiling.
 #define INOUT(T) inout T
 
-layout(std430, binding = 0) readonly buffer PolygonTable { ivec4 polygons[]; };
-layout(std430, binding = 1) readonly buffer EdgeTable { EdgeRecord edges[]; };
-layout(std430, binding = 2) readonly buffer ObjectTable { ObjectRecord objects[]; };
 layout(std140, binding = 3) uniform ParamBlock { KernelParams params; };
 
-// Shaders keep no transport trace.
+#ifdef FLATMARCH_TRACE
+// A probe ray's transport trace: one invocation marches it and appends its events here.
+struct EventRecord {
+  ivec4 kind;  // kind, polygon, edge, to_polygon
+  ivec4 more;  // to_edge, object, 0, 0
+  vec4 at;     // the point (xyz) and t (w)
+};
+layout(std430, binding = 4) buffer EventBuffer {
+  int event_count;
+  int max_events;
+  int trace_steps;
+  int trace_pad;
+  EventRecord trace_events[];
+};
+void record_event(int kind, int polygon, int edge, int to_polygon, int to_edge, int object,
+                  real t, vec3 at) {
+  if (event_count < max_events) {
+    trace_events[event_count] = EventRecord(ivec4(kind, polygon, edge, to_polygon),
+                                            ivec4(to_edge, object, 0, 0), vec4(at, t));
+  }
+  event_count += 1;
+}
+#else
+// Frames keep no transport trace.
 void record_event(int kind, int polygon, int edge, int to_polygon, int to_edge, int object,
                   real t, vec3 at) {}
+#endif

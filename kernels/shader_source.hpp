@@ -1,6 +1,7 @@
 // The kernel as GLSL, specialised on a scene's features: what the OpenGL and Vulkan backends
-// compile, with the tables of kernels/compile.hpp bound as buffers 0-2 and the parameters as
-// uniform block 3 (std430/std140 lay the float tables out as C++ does).
+// compile. The caller supplies the tables (`polygons`, `edges`, `objects`: as buffers, or baked
+// in as constants, kernels/scene_shader.hpp) and appends its main(); the parameters are uniform
+// block 3 (std140 lays KernelParams out as C++ does).
 #pragma once
 
 #include <string>
@@ -9,8 +10,17 @@
 
 namespace flatmarch::kernel {
 
-// `#version 450` and everything up to and including the kernel's functions (march, shade);
-// the caller appends its main().
-std::string shader_source(uint features);
+// The tables as std430 buffers 0-2 (their records lay out as in C++).
+extern const char* const kBufferTables;
+
+// `#version 450`, the constants, the table records, `tables` (GLSL that declares `polygons`,
+// `edges` and `objects`), the parameters and the kernel's functions (march, shade). With
+// `trace`, record_event appends to the event buffer (binding 4) instead of doing nothing.
+std::string shader_source(uint features, const std::string& tables, bool trace = false);
+
+// With the tables as buffers.
+inline std::string shader_source(uint features) {
+  return shader_source(features, kBufferTables);
+}
 
 }  // namespace flatmarch::kernel

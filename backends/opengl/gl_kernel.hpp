@@ -1,0 +1,57 @@
+// The kernel as an OpenGL program, for whichever context is current: the OpenGL backend's
+// (OSMesa, headless) and the viewer's (a GLFW window) draw frames with it alike.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "backends/backend.hpp"
+#include "backends/opengl/gl_api.hpp"
+#include "kernels/camera.hpp"
+#include "kernels/compile.hpp"
+
+namespace flatmarch::gl {
+
+// A shader that does not compile or link. what() has the driver's log and, for each line it
+// names, the generated source around it.
+class ShaderError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The driver's log with the lines of `source` it refers to ("0:LINE(COLUMN): ..." as Mesa and
+// most drivers write them), `context` lines either side, numbered.
+std::string annotate_log(const std::string& source, const std::string& log, int context = 3);
+
+// Compiles and links; throws ShaderError.
+GLuint link_program(const Api& gl, const std::string& vertex, const std::string& fragment);
+
+// The compiled kernel of one scene (its tables baked in), with its parameter block.
+class KernelProgram {
+ public:
+  // `trace`: the variant that marches one probe ray and records its events.
+  KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace);
+  ~KernelProgram();
+  KernelProgram(const KernelProgram&) = delete;
+  KernelProgram& operator=(const KernelProgram&) = delete;
+
+  // Uploads the march parameters and the look (uniform block 3).
+  void set_params(const kernel::Tables<float>::KernelParams& params);
+
+  // Draws the camera's view of a width x height image into the bound framebuffer's draw
+  // buffers 0 (colour) and 1 (AOVs), over its viewport: every pixel within the scissor box.
+  void draw(const CameraBasis<float>& camera, int polygon, glm::vec3 from, int width,
+            int height) const;
+
+  // Marches one ray in a 1 x 1 viewport of the bound framebuffer (a trace program only).
+  Trace trace(const Ray& ray, int max_events) const;
+
+ private:
+  const Api& gl_;
+  bool trace_;
+  GLuint program_ = 0, params_ = 0, vertex_array_ = 0, events_ = 0;
+  GLint polygon_ = -1, from_ = -1, forward_ = -1, right_ = -1, up_ = -1, scale_ = -1, size_ = -1;
+};
+
+}  // namespace flatmarch::gl

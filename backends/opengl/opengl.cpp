@@ -1,0 +1,242 @@
+#include "backends/opengl/opengl.hpp"
+
+#include <GL/osmesa.h>
+
+#include <algorithm>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+#include "backends/opengl/gl_api.hpp"
+#include "backends/opengl/gl_kernel.hpp"
+#include "kernels/scene_shader.hpp"
+
+namespace flatmarch {
+
+namespace {
+
+// Rows drawn per draw call: a frame is drawn in bands so that progress can be reported and no
+// single draw runs for long (a GPU driver's watchdog would end it).
+constexpr int kBandRows = 64;
+// Compiled programs kept per context (a program is a scene's tables and a variant).
+constexpr size_t kProgramCache = 16;
+
+void* osmesa_proc(const char* name) {
+  return reinterpret_cast<void*>(OSMesaGetProcAddress(name));
+}
+
+}  // namespace
+
+struct OpenGlBackend::Context {
+  OSMesaContext osmesa = nullptr;
+  std::vector<unsigned char> surface;  // OSMesa's own framebuffer: unused (we draw to FBOs)
+  gl::Api gl;
+  std::string renderer;
+  GLint max_size = 0;
+  std::mutex mutex;  // one frame or trace at a time; the context is made current per call
+  // Programs by their fragment source, least recently used first.
+  std::vector<std::pair<std::string, std::unique_ptr<gl::KernelProgram>>> programs;
+
+  void make_current() {
+    if (!OSMesaMakeCurrent(osmesa, surface.data(), GL_UNSIGNED_BYTE, 1, 1))
+      throw std::runtime_error("the opengl backend cannot make its OSMesa context current");
+  }
+
+  gl::KernelProgram& program(const kernel::SceneTables<float>& tables, bool trace) {
+    std::string key = kernel::scene_fragment_shader(tables, trace);
+    auto it = std::find_if(programs.begin(), programs.end(),
+                           [&](const auto& p) { return p.first == key; });
+    if (it == programs.end()) {
+      if (programs.size() == kProgramCache) programs.erase(programs.begin());
+      programs.emplace_back(std::move(key), std::make_unique<gl::KernelProgram>(gl, tables, trace));
+      it = programs.end() - 1;
+    } else {
+      std::rotate(it, it + 1, programs.end());  // now the most recently used
+      it = programs.end() - 1;
+    }
+    it->second->set_params(tables.params);
+    return *it->second;
+  }
+
+  ~Context() {
+    if (osmesa != nullptr) {
+      make_current();
+      programs.clear();
+      OSMesaDestroyContext(osmesa);
+    }
+  }
+};
+
+OpenGlBackend::OpenGlBackend() {
+  auto c = std::make_unique<Context>();
+  const int attributes[] = {OSMESA_FORMAT,
+                            OSMESA_RGBA,
+                            OSMESA_DEPTH_BITS,
+                            0,
+                            OSMESA_PROFILE,
+                            OSMESA_CORE_PROFILE,
+                            OSMESA_CONTEXT_MAJOR_VERSION,
+                            4,
+                            OSMESA_CONTEXT_MINOR_VERSION,
+                            5,
+                            0};
+  c->osmesa = OSMesaCreateContextAttribs(attributes, nullptr);
+  if (c->osmesa == nullptr) {
+    unavailable_ = "OSMesa cannot create an OpenGL 4.5 core context here";
+    return;
+  }
+  c->surface.assign(4, 0);
+  try {
+    c->make_current();
+    c->gl = gl::load(osmesa_proc);
+  } catch (const std::exception& e) {
+    unavailable_ = e.what();
+    return;
+  }
+  const auto text = [&](GLenum what) {
+    const GLubyte* s = c->gl.GetString(what);
+    return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
+  };
+  c->renderer = text(GL_RENDERER) + ", " + text(GL_VERSION);
+  c->gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &c->max_size);
+  context_ = std::move(c);
+}
+
+OpenGlBackend::~OpenGlBackend() = default;
+
+std::string OpenGlBackend::description() const {
+  return "the kernel as an OpenGL fragment shader, specialised per scene, headless through "
+         "OSMesa (" +
+         (context_ ? context_->renderer : std::string("unavailable")) + "); f32";
+}
+
+Availability OpenGlBackend::availability() const {
+  if (!context_) return {false, unavailable_};
+  return {};
+}
+
+std::string OpenGlBackend::renderer() const {
+  return context_ ? context_->renderer : "";
+}
+
+namespace {
+
+void check_precision(const MarchParams& params) {
+  if (params.precision != Precision::f32)
+    throw std::invalid_argument(
+        "the opengl backend marches in f32 only (the scalar backend runs f64)");
+}
+
+// A framebuffer with two float colour targets (colour, AOVs) of the frame's size.
+struct Targets {
+  const gl::Api& gl;
+  GLuint framebuffer = 0;
+  GLuint textures[2] = {0, 0};
+
+  Targets(const gl::Api& g, int width, int height) : gl(g) {
+    gl.GenFramebuffers(1, &framebuffer);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    gl.GenTextures(2, textures);
+    for (int k = 0; k < 2; ++k) {
+      gl.BindTexture(GL_TEXTURE_2D, textures[k]);
+      gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(k),
+                              GL_TEXTURE_2D, textures[k], 0);
+    }
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    gl.DrawBuffers(2, buffers);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("the opengl backend cannot draw to float targets of " +
+                               std::to_string(width) + "x" + std::to_string(height));
+  }
+  ~Targets() {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DeleteTextures(2, textures);
+    gl.DeleteFramebuffers(1, &framebuffer);
+  }
+  Targets(const Targets&) = delete;
+  Targets& operator=(const Targets&) = delete;
+};
+
+}  // namespace
+
+Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width, int height,
+                            const MarchParams& params, const Progress& progress) const {
+  check_precision(params);
+  if (!context_) throw std::runtime_error("the opengl backend is unavailable: " + unavailable_);
+  Context& c = *context_;
+  if (width > c.max_size || height > c.max_size)
+    throw std::invalid_argument("the opengl backend renders at most " + std::to_string(c.max_size) +
+                                " pixels a side here");
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+  const std::lock_guard<std::mutex> lock(c.mutex);
+  c.make_current();
+  const gl::Api& gl = c.gl;
+  gl.GetError();  // a clean slate for the check below
+  gl::KernelProgram& program = c.program(tables, false);
+  const Targets targets(gl, width, height);
+  gl.Viewport(0, 0, width, height);
+  gl.Enable(GL_SCISSOR_TEST);
+  const CameraBasis<float> basis = camera_basis<float>(
+      float(camera.yaw_deg), float(camera.pitch_deg), float(camera.fov_deg), width, height);
+  for (int row = 0; row < height; row += kBandRows) {
+    const int rows = std::min(kBandRows, height - row);
+    gl.Scissor(0, height - row - rows, width, rows);  // GL counts rows from the bottom
+    program.draw(basis, camera.polygon, glm::vec3(camera.position), width, height);
+    gl.Finish();
+    if (progress) progress(static_cast<double>(row + rows) / height);
+  }
+  gl.Disable(GL_SCISSOR_TEST);
+
+  Frame frame(width, height);
+  const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+  std::vector<float> colour(4 * pixels), aov(4 * pixels);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, colour.data());
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, aov.data());
+  if (const std::string e = gl::errors(gl); !e.empty())
+    throw std::runtime_error("the opengl backend failed to render: " + e);
+  for (int j = 0; j < height; ++j)
+    for (int i = 0; i < width; ++i) {
+      const size_t from = 4 * (static_cast<size_t>(height - 1 - j) * width + i);
+      const size_t to = frame.pixel(i, j);
+      for (int n = 0; n < 3; ++n) frame.rgb[3 * to + n] = colour[from + n];
+      frame.steps[to] = aov[from];
+      frame.crossings[to] = aov[from + 1];
+      frame.hit[to] = aov[from + 2];
+      frame.t[to] = aov[from + 3];
+    }
+  return frame;
+}
+
+void OpenGlBackend::compile(const std::string& fragment) const {
+  if (!context_) throw std::runtime_error("the opengl backend is unavailable: " + unavailable_);
+  const std::lock_guard<std::mutex> lock(context_->mutex);
+  context_->make_current();
+  context_->gl.DeleteProgram(
+      gl::link_program(context_->gl, kernel::kFullScreenVertexShader, fragment));
+}
+
+Trace OpenGlBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+                           int max_events) const {
+  check_precision(params);
+  if (!context_) throw std::runtime_error("the opengl backend is unavailable: " + unavailable_);
+  Context& c = *context_;
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+  const std::lock_guard<std::mutex> lock(c.mutex);
+  c.make_current();
+  const gl::Api& gl = c.gl;
+  gl.GetError();
+  gl::KernelProgram& program = c.program(tables, true);
+  const Targets targets(gl, 1, 1);
+  Trace trace = program.trace(ray, max_events);
+  if (const std::string e = gl::errors(gl); !e.empty())
+    throw std::runtime_error("the opengl backend failed to trace: " + e);
+  return trace;
+}
+
+}  // namespace flatmarch

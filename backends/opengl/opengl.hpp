@@ -1,0 +1,44 @@
+// The OpenGL backend: the kernel as a fragment shader (kernels/scene_shader.hpp), specialised per
+// scene with its tables baked in, run headless through OSMesa (Mesa's llvmpipe on the CPU). Colour
+// and the AOVs are two float render targets read back into the frame. Float32 only.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "backends/backend.hpp"
+
+namespace flatmarch {
+
+class OpenGlBackend final : public Backend {
+ public:
+  OpenGlBackend();
+  ~OpenGlBackend() override;
+
+  std::string name() const override { return "opengl"; }
+  std::string description() const override;
+  Availability availability() const override;
+  std::vector<Method> methods() const override {
+    return {Method::sphere, Method::relaxed, Method::analytic};
+  }
+  std::vector<Precision> precisions() const override { return {Precision::f32}; }
+  Frame render(const Scene& scene, const Camera& camera, int width, int height,
+               const MarchParams& params, const Progress& progress) const override;
+  Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+              int max_events) const override;
+
+  // Compiles a fragment shader for this backend's program (with the full-screen vertex shader);
+  // throws gl::ShaderError with the driver's log and the source lines it names.
+  void compile(const std::string& fragment) const;
+
+  // The OpenGL renderer and version of its context ("" when unavailable).
+  std::string renderer() const;
+
+ private:
+  struct Context;  // the OSMesa context, its GL functions and compiled programs
+  std::unique_ptr<Context> context_;
+  std::string unavailable_;
+};
+
+}  // namespace flatmarch

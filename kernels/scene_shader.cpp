@@ -1,0 +1,110 @@
+#include "kernels/scene_shader.hpp"
+
+#include <cstdio>
+
+#include "kernels/shader_source.hpp"
+
+namespace flatmarch::kernel {
+
+namespace {
+
+// Nine significant digits read back as the same float.
+std::string number(float x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", static_cast<double>(x));
+  return text;
+}
+
+std::string vec4_literal(const glm::vec4& v) {
+  return "vec4(" + number(v.x) + ", " + number(v.y) + ", " + number(v.z) + ", " + number(v.w) + ")";
+}
+
+std::string ivec4_literal(const ivec4& v) {
+  return "ivec4(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) +
+         ", " + std::to_string(v.w) + ")";
+}
+
+// `const T name[N] = T[N](...);` GLSL has no empty arrays: an empty table gets one zero record
+// that the kernel never reads (it reads only the runs the polygons name).
+template <typename Record, typename F>
+std::string array(const char* type, const char* name, const std::vector<Record>& records,
+                  const std::string& zero, F&& literal) {
+  const size_t n = records.empty() ? 1 : records.size();
+  std::string s = std::string("const ") + type + " " + name + "[" + std::to_string(n) +
+                  "] = " + type + "[" + std::to_string(n) + "](\n";
+  for (size_t k = 0; k < n; ++k) {
+    s += "    " + (records.empty() ? zero : literal(records[k]));
+    s += k + 1 < n ? ",\n" : ");\n";
+  }
+  return s;
+}
+
+const char* const kFragmentMain = R"glsl(
+uniform int u_polygon;
+uniform vec3 u_from;
+uniform vec3 u_forward;
+uniform vec3 u_right;
+uniform vec3 u_up;
+uniform vec2 u_scale;
+uniform vec2 u_size;
+
+layout(location = 0) out vec4 out_color;
+layout(location = 1) out vec4 out_aov;
+
+void main() {
+#ifdef FLATMARCH_TRACE
+  Ray r = march(u_polygon, u_from, u_forward);
+  trace_steps = r.steps;
+  out_color = vec4(0.0);
+  out_aov = vec4(0.0);
+#else
+  // DESIGN.md section 2: x from the left, y from the top, through the pixel's centre
+  // (gl_FragCoord is at the centre, counted from the bottom).
+  vec2 p = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);
+  float u = (2.0 * p.x / u_size.x - 1.0) * u_scale.x;
+  float v = (1.0 - 2.0 * p.y / u_size.y) * u_scale.y;
+  Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));
+  out_color = vec4(shade(r), 1.0);
+  out_aov = vec4(float(r.steps), float(r.crossings), float(r.hit), r.t);
+#endif
+}
+)glsl";
+
+}  // namespace
+
+std::string baked_tables(const SceneTables<float>& tables) {
+  using Edge = Tables<float>::EdgeRecord;
+  using Object = Tables<float>::ObjectRecord;
+  const std::string zero4 = "vec4(0.0)", zeroi = "ivec4(0)";
+  std::string s = "\n// The scene's tables, baked in.\n";
+  s += array("ivec4", "polygons", tables.polygons, zeroi, ivec4_literal);
+  s +=
+      array("EdgeRecord", "edges", tables.edges,
+            "EdgeRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi + ")",
+            [](const Edge& e) {
+              return "EdgeRecord(" + vec4_literal(e.segment) + ", " + vec4_literal(e.line) + ", " +
+                     vec4_literal(e.map_linear) + ", " + vec4_literal(e.map_shift) + ", " +
+                     ivec4_literal(e.link) + ")";
+            });
+  s += array("ObjectRecord", "objects", tables.objects,
+             "ObjectRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi + ")",
+             [](const Object& o) {
+               return "ObjectRecord(" + vec4_literal(o.center) + ", " + vec4_literal(o.shape) +
+                      ", " + vec4_literal(o.color) + ", " + ivec4_literal(o.info) + ")";
+             });
+  return s;
+}
+
+std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace) {
+  return shader_source(tables.features, baked_tables(tables), trace) + kFragmentMain;
+}
+
+const char* const kFullScreenVertexShader = R"glsl(#version 450
+// One triangle that covers the viewport.
+void main() {
+  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)glsl";
+
+}  // namespace flatmarch::kernel

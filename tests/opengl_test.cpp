@@ -1,0 +1,258 @@
+// The OpenGL backend (headless, OSMesa) against the oracle and against the scalar backend, for
+// every gallery scene and method: the hit AOV agrees with the oracle on at least 99% of the
+// pixels of a 160x90 frame (the scalar backend's named out-of-steps exceptions aside), with the
+// scalar backend on at least 99.5%, and generic probe rays follow the oracle's events. Also the
+// generated shader, its compile errors, and the command line. Skipped, visibly, when OSMesa
+// cannot give an OpenGL 4.5 context here.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iostream>
+#include <map>
+
+#include "backends/opengl/gl_kernel.hpp"
+#include "backends/opengl/opengl.hpp"
+#include "backends/scalar/scalar.hpp"
+#include "kernels/scene_shader.hpp"
+#include "tests/gallery.hpp"
+#include "tests/oracle_compare.hpp"
+#include "tests/process.hpp"
+
+namespace flatmarch {
+namespace {
+
+// One backend for the whole test program: its context and compiled programs are reused.
+const OpenGlBackend& opengl() {
+  static const OpenGlBackend backend;
+  return backend;
+}
+
+#define SKIP_WITHOUT_OPENGL()                                       \
+  if (const Availability a = opengl().availability(); !a.available) \
+  GTEST_SKIP() << "the opengl backend is unavailable here: " << a.reason
+
+struct Case {
+  std::string scene;
+  Method method;
+};
+
+class OpenGlConformance : public testing::TestWithParam<Case> {};
+
+TEST_P(OpenGlConformance, HitAovAgreesWithTheOracleAndScalar) {
+  SKIP_WITHOUT_OPENGL();
+  const Scene& scene = test::gallery_scene(GetParam().scene);
+  MarchParams params;
+  params.method = GetParam().method;
+  constexpr int kWidth = 160, kHeight = 90;
+  const Frame truth = OracleBackend().render(scene, scene.camera, kWidth, kHeight, {}, {});
+  const std::vector<std::set<int>> answers = test::oracle_answers(scene, kWidth, kHeight);
+  const Frame scalar = ScalarBackend().render(scene, scene.camera, kWidth, kHeight, params, {});
+  const Frame got = opengl().render(scene, scene.camera, kWidth, kHeight, params, {});
+  ASSERT_EQ(got.hit.size(), truth.hit.size());
+  const double pixels = static_cast<double>(truth.hit.size());
+  size_t acceptable = 0, gave_up = 0, same_as_scalar = 0, same_steps = 0;
+  std::map<std::pair<int, int>, int> confusion;  // (oracle's hit, opengl's hit) -> pixels
+  for (size_t px = 0; px < truth.hit.size(); ++px) {
+    const int hit = static_cast<int>(got.hit[px]);
+    const bool fine = answers[px].count(hit) > 0;
+    acceptable += fine;
+    gave_up += !fine && hit == kHitMaxSteps;
+    same_as_scalar += got.hit[px] == scalar.hit[px];
+    same_steps += got.steps[px] == scalar.steps[px];
+    if (hit != static_cast<int>(truth.hit[px])) ++confusion[{static_cast<int>(truth.hit[px]), hit}];
+    EXPECT_LE(got.steps[px], static_cast<float>(params.max_steps));
+  }
+  const double fraction = static_cast<double>(acceptable) / pixels;
+  std::cout << "[ figures  ] " << scene.name << " " << to_string(params.method) << ": oracle "
+            << 100.0 * fraction << "% (ambiguous pixels allowed), scalar hit "
+            << 100.0 * static_cast<double>(same_as_scalar) / pixels << "%, steps "
+            << 100.0 * static_cast<double>(same_steps) / pixels << "%;";
+  for (const auto& [hits, count] : confusion)
+    std::cout << "  " << hits.first << "->" << hits.second << ": " << count;
+  std::cout << "\n";
+  EXPECT_GE(static_cast<double>(same_as_scalar) / pixels, 0.995);
+  if (!test::out_of_steps_exception(scene.name, params.method)) {
+    EXPECT_GE(fraction, 0.99);
+  } else {  // as the scalar backend: short only by rays that ran out of steps
+    EXPECT_GE(fraction + static_cast<double>(gave_up) / pixels, 0.99);
+  }
+}
+
+TEST_P(OpenGlConformance, GenericRaysFollowTheOraclesEvents) {
+  SKIP_WITHOUT_OPENGL();
+  const Scene& scene = test::gallery_scene(GetParam().scene);
+  const std::vector<Ray> rays = test::generic_rays(scene);
+  ASSERT_EQ(static_cast<int>(rays.size()), test::kRaysPerScene);
+  MarchParams params;
+  params.method = GetParam().method;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    const Trace truth = OracleBackend().trace(scene, rays[k], {}, test::kEvents);
+    const Trace got = opengl().trace(scene, rays[k], params, test::kEvents);
+    ASSERT_EQ(got.events.size(), truth.events.size()) << "ray " << k;
+    for (size_t i = 0; i < truth.events.size(); ++i) {
+      const Event &a = truth.events[i], &b = got.events[i];
+      ASSERT_EQ(test::describe(b), test::describe(a)) << "ray " << k << " event " << i;
+      EXPECT_EQ(b.to_polygon, a.to_polygon);
+      EXPECT_EQ(b.to_edge, a.to_edge);
+      EXPECT_NEAR(b.t, a.t, 1e-2 * scene.scale) << "ray " << k << " event " << i;
+      EXPECT_NEAR(b.at.x, a.at.x, 1e-2 * scene.scale);
+      EXPECT_NEAR(b.at.y, a.at.y, 1e-2 * scene.scale);
+    }
+    EXPECT_GT(got.steps, 0);
+  }
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> all;
+  for (const std::string& name : test::gallery_names())
+    for (Method m : {Method::sphere, Method::relaxed, Method::analytic}) all.push_back({name, m});
+  return all;
+}
+
+INSTANTIATE_TEST_SUITE_P(Gallery, OpenGlConformance, testing::ValuesIn(cases()),
+                         [](const testing::TestParamInfo<Case>& param) {
+                           return param.param.scene + "_" + to_string(param.param.method);
+                         });
+
+TEST(OpenGl, TraceMatchesTheScalarKernelsSteps) {
+  SKIP_WITHOUT_OPENGL();
+  // The same kernel: a probe ray takes as many steps as on the scalar backend (the float
+  // operations may round differently, but not on a generic ray's step count).
+  const Scene& scene = test::gallery_scene("l_shape");
+  MarchParams params;
+  params.method = Method::sphere;
+  for (const Ray& ray : test::generic_rays(scene)) {
+    const Trace a = ScalarBackend().trace(scene, ray, params, 50);
+    const Trace b = opengl().trace(scene, ray, params, 50);
+    EXPECT_NEAR(b.steps, a.steps, 2);
+    EXPECT_EQ(b.events.size(), a.events.size());
+  }
+}
+
+TEST(OpenGl, RefusesFloat64AndSaysWhy) {
+  SKIP_WITHOUT_OPENGL();
+  MarchParams params;
+  params.precision = Precision::f64;
+  const Scene& scene = test::gallery_scene("torus");
+  EXPECT_THROW(
+      {
+        try {
+          opengl().render(scene, scene.camera, 8, 8, params, {});
+        } catch (const std::invalid_argument& e) {
+          EXPECT_NE(std::string(e.what()).find("f32 only"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      std::invalid_argument);
+}
+
+TEST(OpenGl, ReportsProgressInBandsToTheEnd) {
+  SKIP_WITHOUT_OPENGL();
+  const Scene& scene = test::gallery_scene("torus");
+  std::vector<double> seen;
+  opengl().render(scene, scene.camera, 32, 200, {}, [&](double f) { seen.push_back(f); });
+  ASSERT_EQ(seen.size(), 4u);  // 200 rows in bands of 64
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+}
+
+TEST(OpenGl, ImageRowsAreTopDownAsDesignSays) {
+  SKIP_WITHOUT_OPENGL();
+  // In the cube the bottom rows see the floor and the top rows the open sky over the walls: an
+  // image far from symmetric top to bottom, so GL's bottom-up rows must have been flipped for it
+  // to agree with the scalar backend's.
+  const Scene& scene = test::gallery_scene("cube");
+  Camera camera = scene.camera;
+  camera.pitch_deg = 0.0;
+  constexpr int kWidth = 40, kHeight = 30;
+  const Frame scalar = ScalarBackend().render(scene, camera, kWidth, kHeight, {}, {});
+  const Frame got = opengl().render(scene, camera, kWidth, kHeight, {}, {});
+  size_t same = 0, mirrored = 0;
+  for (int j = 0; j < kHeight; ++j)
+    for (int i = 0; i < kWidth; ++i) {
+      same += got.hit[got.pixel(i, j)] == scalar.hit[scalar.pixel(i, j)];
+      mirrored += got.hit[got.pixel(i, j)] == scalar.hit[scalar.pixel(i, kHeight - 1 - j)];
+    }
+  EXPECT_GE(same, got.hit.size() - 6);
+  EXPECT_LT(mirrored, got.hit.size() / 2);  // the test would not see a flip otherwise
+}
+
+TEST(OpenGlShader, BakesTheTablesAndSpecialisesOnTheFeatures) {
+  const Scene& scene = test::gallery_scene("mirror_square");
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
+  const std::string source = kernel::scene_fragment_shader(tables);
+  EXPECT_NE(source.find("const EdgeRecord edges[" + std::to_string(tables.edges.size()) + "]"),
+            std::string::npos);
+  EXPECT_NE(source.find("const uint FEATURES = " + std::to_string(tables.features) + "u;"),
+            std::string::npos);
+  EXPECT_EQ(source.find("readonly buffer EdgeTable"), std::string::npos);  // no table buffers
+  EXPECT_EQ(source.find("#define FLATMARCH_TRACE"), std::string::npos)
+      << "a frame shader records no events";
+  // The first edge's first coordinate, printed to read back as the same float.
+  char first[32];
+  std::snprintf(first, sizeof first, "%.9g", static_cast<double>(tables.edges[0].segment.x));
+  EXPECT_NE(source.find(std::string("EdgeRecord(vec4(") + first), std::string::npos);
+}
+
+TEST(OpenGlShader, CompileErrorsShowTheGeneratedLinesAround) {
+  const std::string source = "line one\nline two\nline three\nline four\nline five\n";
+  const std::string log = "0:3(5): error: `three' undeclared\n0:1(1): warning: unused\n";
+  const std::string text = gl::annotate_log(source, log, 1);
+  EXPECT_NE(text.find(">    3  line three"), std::string::npos) << text;
+  EXPECT_NE(text.find("     2  line two"), std::string::npos) << text;
+  EXPECT_NE(text.find("     4  line four"), std::string::npos) << text;
+  EXPECT_EQ(text.find("line five"), std::string::npos) << text;  // outside the context
+  EXPECT_EQ(text.find(">    1"), std::string::npos) << "warnings are not shown with errors";
+}
+
+TEST(OpenGlShader, DriverErrorsNameTheBrokenLine) {
+  SKIP_WITHOUT_OPENGL();
+  const Scene& scene = test::gallery_scene("torus");
+  std::string source = kernel::scene_fragment_shader(kernel::compile_scene<float>(scene, {}));
+  const std::string call = "Ray r = march(u_polygon, u_from, normalize(";
+  const size_t at = source.find(call);
+  ASSERT_NE(at, std::string::npos);
+  source.replace(at, call.size(), "Ray r = march(no_such_name, u_from, normalize(");
+  try {
+    opengl().compile(source);
+    FAIL() << "a broken shader compiled";
+  } catch (const gl::ShaderError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_name"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find(">  "), std::string::npos) << e.what();
+  }
+}
+
+TEST(OpenGlCli, RendersWithTheOpenGlBackendAndWritesTheAovs) {
+  SKIP_WITHOUT_OPENGL();
+  const std::string dir = test::make_temp_dir();
+  const auto r = test::run_flatmarch(
+      {"render", std::string(FLATMARCH_SOURCE_DIR) + "/scenes/l_shape.json", "--backend", "opengl",
+       "--method", "analytic", "--size", "64x36", "-o", dir + "/l.png"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/l.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/l.exr"));
+}
+
+TEST(OpenGlCli, ShaderPrintsTheSourceAndCompileReportsErrorsWithExit2) {
+  SKIP_WITHOUT_OPENGL();
+  const std::string scene = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
+  const auto printed = test::run_flatmarch({"shader", scene});
+  ASSERT_EQ(printed.exit_code, 0) << printed.err;
+  EXPECT_EQ(printed.out.rfind("#version 450", 0), 0u);
+  EXPECT_NE(printed.out.find("Ray march(int polygon, vec3 from, vec3 dir)"), std::string::npos);
+  const auto compiled = test::run_flatmarch({"shader", scene, "--compile"});
+  EXPECT_EQ(compiled.exit_code, 0) << compiled.err;
+  EXPECT_NE(compiled.err.find("compiles"), std::string::npos);
+
+  const std::string file = test::make_temp_dir() + "/broken.glsl";
+  std::string broken = printed.out;
+  broken.replace(broken.find("out_color = vec4(shade(r), 1.0);"), 32, "out_color = shade(r);");
+  std::ofstream(file) << broken;
+  const auto failed = test::run_flatmarch({"shader", scene, "--compile", "--file", file});
+  EXPECT_EQ(failed.exit_code, 2);
+  EXPECT_NE(failed.err.find("error: " + file), std::string::npos) << failed.err;
+  EXPECT_NE(failed.err.find("out_color = shade(r);"), std::string::npos) << failed.err;
+}
+
+}  // namespace
+}  // namespace flatmarch
