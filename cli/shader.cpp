@@ -19,7 +19,7 @@ void add_shader(CLI::App& app) {
       "on\n"
       "the features the scene uses, with its tables baked in as constants. The march parameters "
       "are\n"
-      "a uniform block (eps, offset and the method change without recompiling). --compile "
+      "baked in too (a change of method or eps is a new program). --compile "
       "compiles it\n"
       "(or a file of yours with --file) and shows any error with the lines around it.");
   struct Options {

@@ -72,6 +72,16 @@ void main() {
 
 }  // namespace
 
+std::string baked_params(const Tables<float>::KernelParams& p) {
+  // In the order of KernelParams' fields (kernels/tables.glsl).
+  return "const KernelParams params = KernelParams(\n    " + std::to_string(p.method) + ", " +
+         std::to_string(p.max_steps) + ", " + std::to_string(p.polygon_count) + ",\n    " +
+         number(p.eps) + ", " + number(p.offset) + ", " + number(p.max_distance) + ", " +
+         number(p.omega) + ",\n    " + number(p.height) + ", " + number(p.top) + ", " +
+         number(p.vertex_tolerance) + ", " + number(p.normal_step) + ", " + number(p.wall_tint) +
+         ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.background) + ");\n";
+}
+
 std::string baked_tables(const SceneTables<float>& tables) {
   using Edge = Tables<float>::EdgeRecord;
   using Object = Tables<float>::ObjectRecord;
@@ -92,7 +102,7 @@ std::string baked_tables(const SceneTables<float>& tables) {
                return "ObjectRecord(" + vec4_literal(o.center) + ", " + vec4_literal(o.shape) +
                       ", " + vec4_literal(o.color) + ", " + ivec4_literal(o.info) + ")";
              });
-  return s;
+  return s + baked_params(tables.params);
 }
 
 std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace) {

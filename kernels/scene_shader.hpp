@@ -9,8 +9,11 @@
 
 namespace flatmarch::kernel {
 
-// The tables as GLSL constant arrays, with exactly the values of `tables` (printed so that they
-// read back as the same floats).
+// The tables as GLSL constant arrays and the parameters as a constant, with exactly the values
+// of `tables` (printed so that they read back as the same floats). Baked in, they let the
+// compiler drop what this scene and these parameters never run (the other methods' code above
+// all): GPU compilers and llvmpipe run both sides of a branch that is not known to be uniform.
+// A change of parameters is a new program.
 std::string baked_tables(const SceneTables<float>& tables);
 
 // Uniforms of the fragment shader (scene_fragment_shader):

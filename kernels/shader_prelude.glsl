@@ -1,9 +1,7 @@
 // The GLSL side of the kernel's subset (see kernels/glsl.hpp): shader_source() puts it between
-// the tables (as buffers 0-2, or baked in as constants) and the kernel. The parameters are
-// uniform block 3, so that eps, offset and the method change without recompiling.
+// the tables and parameters (as buffers 0-2 and uniform block 3, or baked in as constants) and
+// the kernel.
 #define INOUT(T) inout T
-
-layout(std140, binding = 3) uniform ParamBlock { KernelParams params; };
 
 #ifdef FLATMARCH_TRACE
 // A probe ray's transport trace: one invocation marches it and appends its events here.

@@ -1,7 +1,7 @@
 // The kernel as GLSL, specialised on a scene's features: what the OpenGL and Vulkan backends
-// compile. The caller supplies the tables (`polygons`, `edges`, `objects`: as buffers, or baked
-// in as constants, kernels/scene_shader.hpp) and appends its main(); the parameters are uniform
-// block 3 (std140 lays KernelParams out as C++ does).
+// compile. The caller supplies the tables and parameters (`polygons`, `edges`, `objects`,
+// `params`: as buffers and a uniform block, or baked in as constants, kernels/scene_shader.hpp)
+// and appends its main().
 #pragma once
 
 #include <string>
@@ -10,11 +10,12 @@
 
 namespace flatmarch::kernel {
 
-// The tables as std430 buffers 0-2 (their records lay out as in C++).
+// The tables as std430 buffers 0-2 and the parameters as std140 uniform block 3 (their records
+// lay out as in C++).
 extern const char* const kBufferTables;
 
 // `#version 450`, the constants, the table records, `tables` (GLSL that declares `polygons`,
-// `edges` and `objects`), the parameters and the kernel's functions (march, shade). With
+// `edges`, `objects` and `params`) and the kernel's functions (march, shade). With
 // `trace`, record_event appends to the event buffer (binding 4) instead of doing nothing.
 std::string shader_source(uint features, const std::string& tables, bool trace = false);
 

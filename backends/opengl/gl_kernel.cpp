@@ -97,31 +97,19 @@ KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& ta
   up_ = gl.GetUniformLocation(program_, "u_up");
   scale_ = gl.GetUniformLocation(program_, "u_scale");
   size_ = gl.GetUniformLocation(program_, "u_size");
-  gl.GenBuffers(1, &params_);
-  gl.BindBuffer(GL_UNIFORM_BUFFER, params_);
-  gl.BufferData(GL_UNIFORM_BUFFER, sizeof(kernel::Tables<float>::KernelParams), nullptr,
-                GL_DYNAMIC_DRAW);
   gl.GenVertexArrays(1, &vertex_array_);  // the core profile draws only with one bound
   if (trace) gl.GenBuffers(1, &events_);
-  set_params(tables.params);
 }
 
 KernelProgram::~KernelProgram() {
   gl_.DeleteProgram(program_);
-  gl_.DeleteBuffers(1, &params_);
   gl_.DeleteVertexArrays(1, &vertex_array_);
   if (events_ != 0) gl_.DeleteBuffers(1, &events_);
-}
-
-void KernelProgram::set_params(const kernel::Tables<float>::KernelParams& params) {
-  gl_.BindBuffer(GL_UNIFORM_BUFFER, params_);
-  gl_.BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
 }
 
 void KernelProgram::draw(const CameraBasis<float>& c, int polygon, glm::vec3 from, int width,
                          int height) const {
   gl_.UseProgram(program_);
-  gl_.BindBufferBase(GL_UNIFORM_BUFFER, 3, params_);
   gl_.Uniform1i(polygon_, polygon);
   gl_.Uniform3f(from_, from.x, from.y, from.z);
   gl_.Uniform3f(forward_, c.forward.x, c.forward.y, c.forward.z);
@@ -156,7 +144,6 @@ Trace KernelProgram::trace(const Ray& ray, int max_events) const {
   gl_.BufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof header, &header);
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, events_);
   gl_.UseProgram(program_);
-  gl_.BindBufferBase(GL_UNIFORM_BUFFER, 3, params_);
   const glm::vec3 from(ray.from), dir(ray.dir);
   gl_.Uniform1i(polygon_, ray.polygon);
   gl_.Uniform3f(from_, from.x, from.y, from.z);

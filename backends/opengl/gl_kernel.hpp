@@ -27,7 +27,7 @@ std::string annotate_log(const std::string& source, const std::string& log, int 
 // Compiles and links; throws ShaderError.
 GLuint link_program(const Api& gl, const std::string& vertex, const std::string& fragment);
 
-// The compiled kernel of one scene (its tables baked in), with its parameter block.
+// The compiled kernel of one scene and one set of march parameters (both baked in).
 class KernelProgram {
  public:
   // `trace`: the variant that marches one probe ray and records its events.
@@ -35,9 +35,6 @@ class KernelProgram {
   ~KernelProgram();
   KernelProgram(const KernelProgram&) = delete;
   KernelProgram& operator=(const KernelProgram&) = delete;
-
-  // Uploads the march parameters and the look (uniform block 3).
-  void set_params(const kernel::Tables<float>::KernelParams& params);
 
   // Draws the camera's view of a width x height image into the bound framebuffer's draw
   // buffers 0 (colour) and 1 (AOVs), over its viewport: every pixel within the scissor box.
@@ -50,7 +47,7 @@ class KernelProgram {
  private:
   const Api& gl_;
   bool trace_;
-  GLuint program_ = 0, params_ = 0, vertex_array_ = 0, events_ = 0;
+  GLuint program_ = 0, vertex_array_ = 0, events_ = 0;
   GLint polygon_ = -1, from_ = -1, forward_ = -1, right_ = -1, up_ = -1, scale_ = -1, size_ = -1;
 };
 

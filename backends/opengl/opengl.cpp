@@ -18,7 +18,7 @@ namespace {
 // Rows drawn per draw call: a frame is drawn in bands so that progress can be reported and no
 // single draw runs for long (a GPU driver's watchdog would end it).
 constexpr int kBandRows = 64;
-// Compiled programs kept per context (a program is a scene's tables and a variant).
+// Compiled programs kept per context (a program is a scene, its march parameters and a variant).
 constexpr size_t kProgramCache = 16;
 
 void* osmesa_proc(const char* name) {
@@ -54,7 +54,6 @@ struct OpenGlBackend::Context {
       std::rotate(it, it + 1, programs.end());  // now the most recently used
       it = programs.end() - 1;
     }
-    it->second->set_params(tables.params);
     return *it->second;
   }
 
