@@ -86,6 +86,36 @@ GLuint link_program(const Api& gl, const std::string& vertex, const std::string&
   throw ShaderError("the shader program does not link:\n" + log);
 }
 
+RenderTargets::RenderTargets(const Api& gl, int width, int height)
+    : gl_(gl), width_(width), height_(height) {
+  gl.GenFramebuffers(1, &framebuffer_);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
+  gl.GenTextures(2, textures_);
+  for (int k = 0; k < 2; ++k) {
+    gl.BindTexture(GL_TEXTURE_2D, textures_[k]);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(k),
+                            GL_TEXTURE_2D, textures_[k], 0);
+  }
+  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl.DrawBuffers(2, buffers);
+  if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl.DeleteTextures(2, textures_);
+    gl.DeleteFramebuffers(1, &framebuffer_);
+    throw std::runtime_error("OpenGL cannot draw to float targets of " + std::to_string(width) +
+                             "x" + std::to_string(height));
+  }
+}
+
+RenderTargets::~RenderTargets() {
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  gl_.DeleteTextures(2, textures_);
+  gl_.DeleteFramebuffers(1, &framebuffer_);
+}
+
 KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace)
     : gl_(gl), trace_(trace) {
   program_ = link_program(gl, kernel::kFullScreenVertexShader,

@@ -27,6 +27,28 @@ std::string annotate_log(const std::string& source, const std::string& log, int 
 // Compiles and links; throws ShaderError.
 GLuint link_program(const Api& gl, const std::string& vertex, const std::string& fragment);
 
+// A framebuffer with two float colour targets of one size, bound for drawing while it lives:
+// attachment 0 the linear colour (rgb, 1), 1 the AOVs (steps, crossings, hit, t), as
+// KernelProgram draws them.
+class RenderTargets {
+ public:
+  RenderTargets(const Api& gl, int width, int height);
+  ~RenderTargets();
+  RenderTargets(const RenderTargets&) = delete;
+  RenderTargets& operator=(const RenderTargets&) = delete;
+  GLuint framebuffer() const { return framebuffer_; }
+  GLuint colour() const { return textures_[0]; }
+  GLuint aovs() const { return textures_[1]; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  const Api& gl_;
+  GLuint framebuffer_ = 0;
+  GLuint textures_[2] = {0, 0};
+  int width_, height_;
+};
+
 // The compiled kernel of one scene and one set of march parameters (both baked in).
 class KernelProgram {
  public:

@@ -126,39 +126,6 @@ void check_precision(const MarchParams& params) {
         "the opengl backend marches in f32 only (the scalar backend runs f64)");
 }
 
-// A framebuffer with two float colour targets (colour, AOVs) of the frame's size.
-struct Targets {
-  const gl::Api& gl;
-  GLuint framebuffer = 0;
-  GLuint textures[2] = {0, 0};
-
-  Targets(const gl::Api& g, int width, int height) : gl(g) {
-    gl.GenFramebuffers(1, &framebuffer);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    gl.GenTextures(2, textures);
-    for (int k = 0; k < 2; ++k) {
-      gl.BindTexture(GL_TEXTURE_2D, textures[k]);
-      gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(k),
-                              GL_TEXTURE_2D, textures[k], 0);
-    }
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    gl.DrawBuffers(2, buffers);
-    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw std::runtime_error("the opengl backend cannot draw to float targets of " +
-                               std::to_string(width) + "x" + std::to_string(height));
-  }
-  ~Targets() {
-    gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    gl.DeleteTextures(2, textures);
-    gl.DeleteFramebuffers(1, &framebuffer);
-  }
-  Targets(const Targets&) = delete;
-  Targets& operator=(const Targets&) = delete;
-};
-
 }  // namespace
 
 Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width, int height,
@@ -175,7 +142,7 @@ Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width,
   const gl::Api& gl = c.gl;
   gl.GetError();  // a clean slate for the check below
   gl::KernelProgram& program = c.program(tables, false);
-  const Targets targets(gl, width, height);
+  const gl::RenderTargets targets(gl, width, height);
   gl.Viewport(0, 0, width, height);
   gl.Enable(GL_SCISSOR_TEST);
   const CameraBasis<float> basis = camera_basis<float>(
@@ -231,7 +198,7 @@ Trace OpenGlBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   const gl::Api& gl = c.gl;
   gl.GetError();
   gl::KernelProgram& program = c.program(tables, true);
-  const Targets targets(gl, 1, 1);
+  const gl::RenderTargets targets(gl, 1, 1);
   Trace trace = program.trace(ray, max_events);
   if (const std::string e = gl::errors(gl); !e.empty())
     throw std::runtime_error("the opengl backend failed to trace: " + e);
