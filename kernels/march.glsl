@@ -23,6 +23,13 @@ bool has(uint feature) {
   return (FEATURES & feature) != 0u;
 }
 
+// The polygon whose table entries to read: `polygon`, or 0 in a scene of one polygon. The same
+// number, but a shader with the scene baked in then reads constant entries, and its compiler
+// unrolls the loops over the room's edges and folds their numbers in (no per-lane reads).
+int room(int polygon) {
+  return params.polygon_count == 1 ? 0 : polygon;
+}
+
 // What a ray is doing, and once `done`, how it ended.
 struct Ray {
   int polygon;
@@ -62,7 +69,7 @@ bool crosses(vec2 a, vec2 ab, vec2 p) {
 }
 
 bool inside_polygon(int polygon, vec2 p) {
-  ivec4 poly = polygons[polygon];
+  ivec4 poly = polygons[room(polygon)];
   bool inside = false;
   for (int k = poly.x; k < poly.x + poly.y; ++k) {
     vec4 s = edges[k].segment;
@@ -80,7 +87,7 @@ struct WallDistance {
 };
 
 WallDistance wall_distance(int polygon, vec2 p) {
-  ivec4 poly = polygons[polygon];
+  ivec4 poly = polygons[room(polygon)];
   real best = real(kFar);
   real second = real(kFar);
   int edge = -1;
@@ -118,7 +125,7 @@ struct Exit {
 };
 
 Exit exit_edge(int polygon, vec2 o, vec2 dh) {
-  ivec4 poly = polygons[polygon];
+  ivec4 poly = polygons[room(polygon)];
   Exit x;
   x.s = real(kFar);
   x.edge = -1;
@@ -161,7 +168,7 @@ vec2 place(vec2 p, vec4 line, real inside) {
 // paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
 // one it was.
 void cross_edge(INOUT(Ray) r, int k, real push) {
-  int e = polygons[r.polygon].x + k;
+  int e = polygons[room(r.polygon)].x + k;
   vec4 line = edges[e].line;
   vec2 dh = vec2(r.d);
   if (has(kFeatureMirrors) && edges[e].link.x == kEdgeMirror) {
@@ -177,7 +184,7 @@ void cross_edge(INOUT(Ray) r, int k, real push) {
     vec2 p = vec2(r.o);
     p = vec2(m.x * p.x + m.z * p.y, m.y * p.x + m.w * p.y) + vec2(shift.x, shift.y);
     dh = vec2(m.x * dh.x + m.z * dh.y, m.y * dh.x + m.w * dh.y);
-    r.o = vec3(place(p, edges[polygons[link.y].x + link.z].line, push), r.o.z);
+    r.o = vec3(place(p, edges[polygons[room(link.y)].x + link.z].line, push), r.o.z);
     r.d = vec3(dh, r.d.z);
     // Under a map that is not an isometry the direction is renormalised (DESIGN.md section 1).
     if (has(kFeatureScaled)) r.d = normalize(r.d);
@@ -187,7 +194,7 @@ void cross_edge(INOUT(Ray) r, int k, real push) {
 }
 
 bool is_wall(int polygon, int k) {
-  return has(kFeatureWalls) && edges[polygons[polygon].x + k].link.x == kEdgeWall;
+  return has(kFeatureWalls) && edges[polygons[room(polygon)].x + k].link.x == kEdgeWall;
 }
 
 // The ray reaches the top or bottom of the band, `s` further on.
@@ -232,7 +239,7 @@ SolidDistance nearest_solid(int polygon, vec3 p) {
   best.d = real(kFar);
   best.object = -1;
   if (!has(kFeatureObjects)) return best;
-  ivec4 poly = polygons[polygon];
+  ivec4 poly = polygons[room(polygon)];
   for (int k = poly.z; k < poly.z + poly.w; ++k) {
     real d = solid_distance(k, p);
     if (d < best.d) {
@@ -245,7 +252,7 @@ SolidDistance nearest_solid(int polygon, vec3 p) {
 
 // Where a ray first comes within eps of a solid's bounding sphere in its room, or kFar.
 real solid_entry(int polygon, vec3 o, vec3 d) {
-  ivec4 poly = polygons[polygon];
+  ivec4 poly = polygons[room(polygon)];
   real first = real(kFar);
   for (int k = poly.z; k < poly.z + poly.w; ++k) {
     vec4 c = objects[k].center;
