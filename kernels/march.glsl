@@ -40,6 +40,7 @@ struct Ray {
   int crossings;  // gluings crossed and mirror bounces
   int hit;        // the hit AOV, once done
   bool done;
+  int object;    // the index in the object table of the solid hit, or -1
   vec3 normal;   // of the solid hit
   vec3 surface;  // the colour of the solid hit
 };
@@ -283,10 +284,16 @@ vec3 solid_surface(vec4 color, vec3 normal) {
   return color.w > real(0) ? vec3(color) : real(0.5) + real(0.5) * normal;
 }
 
+// Its normal and colour are left to the end of the march (solid_look): a shader runs all of a
+// loop's body for every ray, taken branch or not, and these are the costliest few lines.
 void hit_solid(INOUT(Ray) r, int k) {
-  r.normal = solid_normal(k, r.o);
-  r.surface = solid_surface(objects[k].color, r.normal);
+  r.object = k;
   finish(r, objects[k].info.y, kEventObject, -1, real(0));
+}
+
+void solid_look(INOUT(Ray) r) {
+  r.normal = solid_normal(r.object, r.o);
+  r.surface = solid_surface(objects[r.object].color, r.normal);
 }
 
 // ---- Methods ---------------------------------------------------------------------------------
@@ -441,6 +448,7 @@ Ray march(int polygon, vec3 from, vec3 dir) {
   r.crossings = 0;
   r.hit = kHitMaxSteps;
   r.done = false;
+  r.object = -1;
   r.normal = vec3(real(0));
   r.surface = vec3(real(0));
   if (has(kFeaturePeriod)) {
@@ -465,6 +473,7 @@ Ray march(int polygon, vec3 from, vec3 dir) {
     }
   }
   if (!r.done) finish(r, kHitMaxSteps, kEventMaxSteps, -1, real(0));
+  if (has(kFeatureObjects) && r.object >= 0) solid_look(r);
   return r;
 }
 
