@@ -30,6 +30,22 @@ int room(int polygon) {
   return params.polygon_count == 1 ? 0 : polygon;
 }
 
+// Edge k of a polygon's room. In a baked shader of a one-polygon scene the edge is picked from
+// constants rather than read at a per-ray index (a gather, the slowest read a SIMD shader core
+// makes); the record is the same.
+EdgeRecord edge_at(int polygon, int k) {
+#ifdef FLATMARCH_SHADER
+  if (params.polygon_count == 1) {
+    EdgeRecord e = edges[0];
+    for (int j = 1; j < polygons[0].y; ++j) {
+      if (j == k) e = edges[j];
+    }
+    return e;
+  }
+#endif
+  return edges[polygons[room(polygon)].x + k];
+}
+
 // What a ray is doing, and once `done`, how it ended.
 struct Ray {
   int polygon;
@@ -169,23 +185,23 @@ vec2 place(vec2 p, vec4 line, real inside) {
 // paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
 // one it was.
 void cross_edge(INOUT(Ray) r, int k, real push) {
-  int e = polygons[room(r.polygon)].x + k;
-  vec4 line = edges[e].line;
+  EdgeRecord edge = edge_at(r.polygon, k);
+  vec4 line = edge.line;
   vec2 dh = vec2(r.d);
-  if (has(kFeatureMirrors) && edges[e].link.x == kEdgeMirror) {
+  if (has(kFeatureMirrors) && edge.link.x == kEdgeMirror) {
     record_event(kEventMirror, r.polygon, k, -1, -1, -1, r.t, r.o);
     vec2 n = vec2(line.x, line.y);
     r.o = vec3(place(vec2(r.o), line, push), r.o.z);
     r.d = vec3(dh - real(2) * dot(dh, n) * n, r.d.z);
   } else {
-    ivec4 link = edges[e].link;
+    ivec4 link = edge.link;
     record_event(kEventGluing, r.polygon, k, link.y, link.z, -1, r.t, r.o);
-    vec4 m = edges[e].map_linear;
-    vec4 shift = edges[e].map_shift;
+    vec4 m = edge.map_linear;
+    vec4 shift = edge.map_shift;
     vec2 p = vec2(r.o);
     p = vec2(m.x * p.x + m.z * p.y, m.y * p.x + m.w * p.y) + vec2(shift.x, shift.y);
     dh = vec2(m.x * dh.x + m.z * dh.y, m.y * dh.x + m.w * dh.y);
-    r.o = vec3(place(p, edges[polygons[room(link.y)].x + link.z].line, push), r.o.z);
+    r.o = vec3(place(p, edge_at(link.y, link.z).line, push), r.o.z);
     r.d = vec3(dh, r.d.z);
     // Under a map that is not an isometry the direction is renormalised (DESIGN.md section 1).
     if (has(kFeatureScaled)) r.d = normalize(r.d);
@@ -195,7 +211,7 @@ void cross_edge(INOUT(Ray) r, int k, real push) {
 }
 
 bool is_wall(int polygon, int k) {
-  return has(kFeatureWalls) && edges[polygons[room(polygon)].x + k].link.x == kEdgeWall;
+  return has(kFeatureWalls) && edge_at(polygon, k).link.x == kEdgeWall;
 }
 
 // The ray reaches the top or bottom of the band, `s` further on.

@@ -2,6 +2,7 @@
 // the tables and parameters (as buffers 0-2 and uniform block 3, or baked in as constants) and
 // the kernel.
 #define INOUT(T) inout T
+#define FLATMARCH_SHADER
 
 #ifdef FLATMARCH_TRACE
 // A probe ray's transport trace: one invocation marches it and appends its events here.
