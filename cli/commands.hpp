@@ -13,5 +13,6 @@ void add_gallery(CLI::App& app);
 void add_plan(CLI::App& app);
 void add_import_peer(CLI::App& app);
 void add_shader(CLI::App& app);
+void add_view(CLI::App& app);
 
 }  // namespace flatmarch::cli

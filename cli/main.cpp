@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   cli::add_gallery(app);
   cli::add_import_peer(app);
   cli::add_shader(app);
+  cli::add_view(app);
   // CLI11 would only say that a subcommand is required.
   const auto subcommands = app.get_subcommands([](const CLI::App*) { return true; });
   const auto known = [&](const char* name) {
