@@ -66,7 +66,16 @@ struct OpenGlBackend::Context {
   }
 };
 
-OpenGlBackend::OpenGlBackend() {
+OpenGlBackend::OpenGlBackend() = default;
+
+// The context is made on first use, not when the backend is listed: every command builds the
+// backend registry, and few draw.
+OpenGlBackend::Context* OpenGlBackend::context() const {
+  std::call_once(made_, [this] { make_context(); });
+  return context_.get();
+}
+
+void OpenGlBackend::make_context() const {
   auto c = std::make_unique<Context>();
   const int attributes[] = {OSMESA_FORMAT,
                             OSMESA_RGBA,
@@ -103,19 +112,25 @@ OpenGlBackend::OpenGlBackend() {
 
 OpenGlBackend::~OpenGlBackend() = default;
 
+namespace {
+[[noreturn]] void unavailable(const std::string& why) {
+  throw std::runtime_error("the opengl backend is unavailable: " + why);
+}
+}  // namespace
+
 std::string OpenGlBackend::description() const {
   return "the kernel as an OpenGL fragment shader, specialised per scene, headless through "
          "OSMesa (" +
-         (context_ ? context_->renderer : std::string("unavailable")) + "); f32";
+         (context() ? context_->renderer : std::string("unavailable")) + "); f32";
 }
 
 Availability OpenGlBackend::availability() const {
-  if (!context_) return {false, unavailable_};
+  if (!context()) return {false, unavailable_};
   return {};
 }
 
 std::string OpenGlBackend::renderer() const {
-  return context_ ? context_->renderer : "";
+  return context() ? context_->renderer : "";
 }
 
 namespace {
@@ -131,7 +146,7 @@ void check_precision(const MarchParams& params) {
 Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width, int height,
                             const MarchParams& params, const Progress& progress) const {
   check_precision(params);
-  if (!context_) throw std::runtime_error("the opengl backend is unavailable: " + unavailable_);
+  if (!context()) unavailable(unavailable_);
   Context& c = *context_;
   if (width > c.max_size || height > c.max_size)
     throw std::invalid_argument("the opengl backend renders at most " + std::to_string(c.max_size) +
@@ -180,7 +195,7 @@ Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width,
 }
 
 void OpenGlBackend::compile(const std::string& fragment) const {
-  if (!context_) throw std::runtime_error("the opengl backend is unavailable: " + unavailable_);
+  if (!context()) unavailable(unavailable_);
   const std::lock_guard<std::mutex> lock(context_->mutex);
   context_->make_current();
   context_->gl.DeleteProgram(
@@ -190,7 +205,7 @@ void OpenGlBackend::compile(const std::string& fragment) const {
 Trace OpenGlBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params,
                            int max_events) const {
   check_precision(params);
-  if (!context_) throw std::runtime_error("the opengl backend is unavailable: " + unavailable_);
+  if (!context()) unavailable(unavailable_);
   Context& c = *context_;
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const std::lock_guard<std::mutex> lock(c.mutex);

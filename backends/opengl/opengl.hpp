@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -36,9 +37,13 @@ class OpenGlBackend final : public Backend {
   std::string renderer() const;
 
  private:
-  struct Context;  // the OSMesa context, its GL functions and compiled programs
-  std::unique_ptr<Context> context_;
-  std::string unavailable_;
+  struct Context;            // the OSMesa context, its GL functions and compiled programs
+  Context* context() const;  // null when unavailable (unavailable_ says why)
+  void make_context() const;
+
+  mutable std::once_flag made_;
+  mutable std::unique_ptr<Context> context_;
+  mutable std::string unavailable_;
 };
 
 }  // namespace flatmarch
