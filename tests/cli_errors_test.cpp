@@ -337,7 +337,8 @@ INSTANTIATE_TEST_SUITE_P(
     [](const testing::TestParamInfo<ArgCase>& p) { return std::string(p.param.name); });
 
 TEST(Cli, EverySubcommandHasHelp) {
-  for (const char* command : {"inspect", "render", "trace", "backends", "gallery", "import-peer"}) {
+  for (const char* command : {"inspect", "render", "trace", "backends", "gallery", "import-peer",
+                              "plan", "shader", "view"}) {
     const auto r = run_flatmarch({command, "--help"});
     EXPECT_EQ(r.exit_code, 0) << command;
     EXPECT_NE(r.out.find("Usage: flatmarch " + std::string(command)), std::string::npos)
