@@ -134,7 +134,8 @@ WallDistance wall_distance(int polygon, vec2 p) {
 
 // The edge through which a ray from o along dh leaves its polygon, at distance s along the ray
 // (d's horizontal part has the length that makes s a 3D distance), and whether it leaves at a
-// vertex.
+// vertex. (Its loop, like the kernel's other loops, has no `continue` or early `return`:
+// llvmpipe runs such loops at half the speed.)
 struct Exit {
   real s;
   int edge;
@@ -151,17 +152,20 @@ Exit exit_edge(int polygon, vec2 o, vec2 dh) {
     vec4 line = edges[poly.x + k].line;
     vec2 n = vec2(line.x, line.y);
     real dn = dot(dh, n);
-    if (dn <= real(0)) continue;  // the ray cannot leave through this edge
-    real s = (line.z - dot(o, n)) / dn;
-    if (s < -params.vertex_tolerance || s >= x.s) continue;
-    vec4 seg = edges[poly.x + k].segment;
-    vec2 a = vec2(seg.x, seg.y);
-    real u = dot(o + s * dh - a, vec2(seg.z, seg.w) - a) * line.w;  // 0 at a, 1 at b
-    real tolerance = params.vertex_tolerance * sqrt(line.w);        // in units of u
-    if (u < -tolerance || u > real(1) + tolerance) continue;
-    x.s = max(s, real(0));
-    x.edge = k;
-    x.corner = u <= tolerance || u >= real(1) - tolerance;
+    if (dn > real(0)) {  // else the ray cannot leave through this edge
+      real s = (line.z - dot(o, n)) / dn;
+      if (s >= -params.vertex_tolerance && s < x.s) {
+        vec4 seg = edges[poly.x + k].segment;
+        vec2 a = vec2(seg.x, seg.y);
+        real u = dot(o + s * dh - a, vec2(seg.z, seg.w) - a) * line.w;  // 0 at a, 1 at b
+        real tolerance = params.vertex_tolerance * sqrt(line.w);        // in units of u
+        if (u >= -tolerance && u <= real(1) + tolerance) {
+          x.s = max(s, real(0));
+          x.edge = k;
+          x.corner = u <= tolerance || u >= real(1) - tolerance;
+        }
+      }
+    }
   }
   return x;
 }
@@ -271,17 +275,18 @@ SolidDistance nearest_solid(int polygon, vec3 p) {
 real solid_entry(int polygon, vec3 o, vec3 d) {
   ivec4 poly = polygons[room(polygon)];
   real first = real(kFar);
+  bool inside = false;  // already inside one
   for (int k = poly.z; k < poly.z + poly.w; ++k) {
     vec4 c = objects[k].center;
     vec3 oc = o - vec3(c);
     real radius = c.w + params.eps;
     real b = dot(oc, d);
     real cc = dot(oc, oc) - radius * radius;
-    if (cc <= real(0)) return real(0);  // already inside one
+    inside = inside || cc <= real(0);
     real disc = b * b - cc;
     if (b < real(0) && disc >= real(0)) first = min(first, -b - sqrt(disc));
   }
-  return first;
+  return inside ? real(0) : first;
 }
 
 // The gradient of the solid's distance by central differences on a tetrahedron.
@@ -435,15 +440,20 @@ void enter_band(INOUT(Ray) r) {
   real s = toward ? ((above ? params.height : real(0)) - r.o.z) / r.d.z : params.max_distance;
   if (s > params.max_distance) s = params.max_distance;  // the band is out of reach
   vec3 q = r.o + s * r.d;
-  for (int k = 0; k < params.polygon_count && s < params.max_distance; ++k) {
-    if (!inside_polygon(k, vec2(q))) continue;
-    r.polygon = k;
+  int entered = -1;  // the first polygon whose footprint q is in
+  if (s < params.max_distance) {
+    for (int k = params.polygon_count - 1; k >= 0; --k) {
+      if (inside_polygon(k, vec2(q))) entered = k;
+    }
+  }
+  if (entered >= 0) {
+    r.polygon = entered;
     if (!above && has(kFeatureFloor)) {  // the underside of the floor
       finish(r, kHitFloor, kEventFloor, -1, s);
       r.normal = vec3(real(0), real(0), real(-1));
     } else {
       advance(r, s);
-      record_event(kEventEnter, k, -1, -1, -1, -1, r.t, r.o);
+      record_event(kEventEnter, entered, -1, -1, -1, -1, r.t, r.o);
     }
     return;
   }
