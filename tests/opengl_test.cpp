@@ -13,21 +13,14 @@
 #include "backends/scalar/scalar.hpp"
 #include "kernels/scene_shader.hpp"
 #include "tests/gallery.hpp"
+#include "tests/opengl_backend.hpp"
 #include "tests/oracle_compare.hpp"
 #include "tests/process.hpp"
 
 namespace flatmarch {
 namespace {
 
-// One backend for the whole test program: its context and compiled programs are reused.
-const OpenGlBackend& opengl() {
-  static const OpenGlBackend backend;
-  return backend;
-}
-
-#define SKIP_WITHOUT_OPENGL()                                       \
-  if (const Availability a = opengl().availability(); !a.available) \
-  GTEST_SKIP() << "the opengl backend is unavailable here: " << a.reason
+using test::opengl;
 
 TEST(OpenGl, TraceMatchesTheScalarKernelsSteps) {
   SKIP_WITHOUT_OPENGL();
