@@ -1,6 +1,8 @@
 #include "backends/backend.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cstring>
 #include <utility>
 
 #include "backends/kernel_trace.hpp"
@@ -8,6 +10,7 @@
 #include "backends/oracle/oracle.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/simd.hpp"
+#include "backends/vulkan/vulkan.hpp"
 
 namespace flatmarch {
 
@@ -82,8 +85,26 @@ Trace kernel_trace(const std::vector<kernel::KernelEvent>& events, int steps) {
   return trace;
 }
 
+size_t shader_trace_bytes(int max_events) {
+  return sizeof(ShaderEventHeader) +
+         sizeof(ShaderEventRecord) * static_cast<size_t>(std::max(max_events, 0));
+}
+
+Trace shader_trace(const unsigned char* buffer, int max_events) {
+  ShaderEventHeader header;
+  std::memcpy(&header, buffer, sizeof header);
+  std::vector<kernel::KernelEvent> events;
+  for (int k = 0; k < std::min(header.count, max_events); ++k) {
+    ShaderEventRecord e;
+    std::memcpy(&e, buffer + sizeof header + sizeof e * static_cast<size_t>(k), sizeof e);
+    events.push_back({e.kind[0], e.kind[1], e.kind[2], e.kind[3], e.more[0], e.more[1],
+                      static_cast<double>(e.at[3]), glm::dvec3(e.at[0], e.at[1], e.at[2])});
+  }
+  return kernel_trace(events, header.steps);
+}
+
 namespace {
-constexpr std::array<const char*, 4> kBackendNames{"oracle", "scalar", "simd", "opengl"};
+constexpr std::array<const char*, 5> kBackendNames{"oracle", "scalar", "simd", "opengl", "vulkan"};
 }  // namespace
 
 std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOptions& options) {
@@ -91,6 +112,7 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOpti
   if (name == "scalar") return std::make_unique<ScalarBackend>();
   if (name == "simd") return std::make_unique<SimdBackend>(options);
   if (name == "opengl") return std::make_unique<OpenGlBackend>();
+  if (name == "vulkan") return std::make_unique<VulkanBackend>(options);
   return nullptr;
 }
 

@@ -118,10 +118,16 @@ struct Availability {
   std::string reason;  // why not, when unavailable
 };
 
-// How a backend runs, where it has a choice (command-line options --isa, --threads).
+// How a backend runs, where it has a choice (command-line options --isa, --threads, --device).
 struct BackendOptions {
-  std::string isa;  // simd: the instruction set (see `flatmarch backends`); empty: the best here
-  int threads = 0;  // simd: worker threads; 0: all cores
+  std::string isa{};  // simd: the instruction set (see `flatmarch backends`); empty: the best here
+  int threads = 0;    // simd: worker threads; 0: all cores
+  // vulkan: the device, by its index or a part of its name (see `flatmarch backends`); empty: a
+  // discrete GPU if there is one, else an integrated, a virtual GPU, the CPU (lavapipe).
+  std::string device{};
+  // vulkan: run under the Khronos validation layer, and fail a frame or trace on any message it
+  // sends. Also on when the environment sets FLATMARCH_VULKAN_VALIDATION=1.
+  bool validation = false;
 };
 
 // Called now and then during long work with the fraction done, in [0, 1].

@@ -72,8 +72,10 @@ int main(int argc, char** argv) {
     params.method = method;
     const std::string name = std::string("simd/") + to_string(method) + "/" + scene->name + "/" +
                              isa + "/threads:" + std::to_string(threads);
-    benchmark::RegisterBenchmark(name.c_str(), simd_frame, scene, params,
-                                 BackendOptions{.isa = isa, .threads = threads})
+    BackendOptions options;
+    options.isa = isa;
+    options.threads = threads;
+    benchmark::RegisterBenchmark(name.c_str(), simd_frame, scene, params, options)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   };

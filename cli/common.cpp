@@ -91,6 +91,9 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
                  "the best this CPU runs)");
   app.add_option("--threads", backend_options.threads, "simd: worker threads (0: all cores)")
       ->capture_default_str();
+  app.add_option("--device", backend_options.device,
+                 "vulkan: the device, by its index or a part of its name as `flatmarch backends` "
+                 "lists them (default: a discrete GPU, else an integrated one, else the CPU)");
 }
 
 const Backend& MarchOptions::resolve() {

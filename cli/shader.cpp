@@ -4,6 +4,7 @@
 
 #include "backends/opengl/gl_kernel.hpp"
 #include "backends/opengl/opengl.hpp"
+#include "backends/vulkan/vulkan.hpp"
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "kernels/compile.hpp"
@@ -15,23 +16,25 @@ namespace flatmarch::cli {
 void add_shader(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "shader",
-      "Print the GLSL fragment shader the opengl backend runs for a scene: the kernel specialised "
-      "on\n"
-      "the features the scene uses, with its tables baked in as constants. The march parameters "
-      "are\n"
-      "baked in too (a change of method or eps is a new program). --compile "
-      "compiles it\n"
-      "(or a file of yours with --file) and shows any error with the lines around it.");
+      "Print the GLSL shader a GPU backend runs for a scene: the opengl backend's fragment shader\n"
+      "or the vulkan backend's compute shader (--backend vulkan), the kernel specialised on the\n"
+      "features the scene uses, with its tables baked in as constants. The march parameters are\n"
+      "baked in too (a change of method or eps is a new program). --compile compiles it (or a\n"
+      "file of yours with --file) and shows any error with the lines around it.");
   struct Options {
-    std::string scene, file, out;
+    std::string scene, file, out, backend = "opengl";
     bool trace = false, compile = false;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("SCENE", o->scene, "Scene file (JSON)")->required();
   cmd->add_option("-o,--output", o->out, "Write the source here instead of to stdout");
   cmd->add_flag("--trace", o->trace, "The variant that traces one probe ray (its events)");
+  cmd->add_option("--backend", o->backend,
+                  "opengl (a fragment shader) or vulkan (a compute shader)")
+      ->capture_default_str();
   cmd->add_flag("--compile", o->compile,
-                "Compile it with the opengl backend (OSMesa) and report errors");
+                "Compile it with that backend (OSMesa's driver; glslang and the Vulkan device) and "
+                "report errors");
   cmd->add_option("--file", o->file,
                   "With --compile: compile this fragment shader instead of the generated one")
       ->check(CLI::ExistingFile);
@@ -39,8 +42,12 @@ void add_shader(CLI::App& app) {
     const Scene scene = load_scene(o->scene);
     MarchParams params;
     params.method = Method::analytic;
-    std::string source =
-        kernel::scene_fragment_shader(kernel::compile_scene<float>(scene, params), o->trace);
+    if (o->backend != "opengl" && o->backend != "vulkan")
+      throw UsageError("--backend: expected opengl or vulkan, got \"" + o->backend + "\"");
+    const bool vulkan = o->backend == "vulkan";
+    const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+    std::string source = vulkan ? kernel::scene_compute_shader(tables, o->trace)
+                                : kernel::scene_fragment_shader(tables, o->trace);
     if (!o->file.empty()) {
       if (!o->compile) throw UsageError("--file: goes with --compile");
       std::ifstream in(o->file, std::ios::binary);
@@ -49,18 +56,23 @@ void add_shader(CLI::App& app) {
       source = text.str();
     }
     if (o->compile) {
-      const OpenGlBackend backend;
+      const OpenGlBackend opengl;
+      const VulkanBackend vulkan_backend;
+      const Backend& backend = vulkan ? static_cast<const Backend&>(vulkan_backend) : opengl;
       if (const Availability a = backend.availability(); !a.available)
-        throw UnavailableError("backend opengl is unavailable here: " + a.reason);
+        throw UnavailableError("backend " + o->backend + " is unavailable here: " + a.reason);
       try {
-        backend.compile(source);
-      } catch (const gl::ShaderError& e) {
+        if (vulkan)
+          vulkan_backend.compile(source);
+        else
+          opengl.compile(source);
+      } catch (const kernel::ShaderError& e) {
         throw UsageError(std::string(o->file.empty() ? "the generated shader" : o->file) + ": " +
                          e.what());
       }
       std::fprintf(stderr, "%s compiles (%s, %zu lines)\n",
                    o->file.empty() ? "the generated shader" : o->file.c_str(),
-                   backend.renderer().c_str(),
+                   vulkan ? vulkan_backend.description().c_str() : opengl.renderer().c_str(),
                    static_cast<size_t>(std::count(source.begin(), source.end(), '\n')));
       if (!o->file.empty()) return;
     }

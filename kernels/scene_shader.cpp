@@ -27,11 +27,11 @@ std::string ivec4_literal(const ivec4& v) {
 // `const T name[N] = T[N](...);` GLSL has no empty arrays: an empty table gets one zero record
 // that the kernel never reads (it reads only the runs the polygons name).
 template <typename Record, typename F>
-std::string array(const char* type, const char* name, const std::vector<Record>& records,
-                  const std::string& zero, F&& literal) {
+std::string array(bool constant, const char* type, const char* name,
+                  const std::vector<Record>& records, const std::string& zero, F&& literal) {
   const size_t n = records.empty() ? 1 : records.size();
-  std::string s = std::string("const ") + type + " " + name + "[" + std::to_string(n) +
-                  "] = " + type + "[" + std::to_string(n) + "](\n";
+  std::string s = std::string(constant ? "const " : "") + type + " " + name + "[" +
+                  std::to_string(n) + "] = " + type + "[" + std::to_string(n) + "](\n";
   for (size_t k = 0; k < n; ++k) {
     s += "    " + (records.empty() ? zero : literal(records[k]));
     s += k + 1 < n ? ",\n" : ");\n";
@@ -70,6 +70,50 @@ void main() {
 }
 )glsl";
 
+// The Vulkan backend's main() (see scene_compute_shader). The pixel's ray is computed as the
+// fragment shader computes it.
+const char* const kComputeMain = R"glsl(
+layout(push_constant) uniform Constants {
+  vec4 from;
+  vec4 forward;
+  vec4 right;
+  vec4 up;
+  vec4 scale;
+  ivec4 frame;  // width, height, first row, polygon
+} pc;
+
+#ifdef FLATMARCH_TRACE
+layout(local_size_x = 1) in;
+void main() {
+  Ray r = march(pc.frame.w, pc.from.xyz, pc.forward.xyz);
+  trace_steps = r.steps;
+}
+#else
+layout(local_size_x = TILE, local_size_y = TILE) in;
+layout(std430, binding = 5) writeonly buffer Pixels { float pixels[]; };
+void main() {
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, pc.frame.z);
+  if (p.x < pc.frame.x && p.y < pc.frame.y) {
+    vec2 size = vec2(pc.frame.xy);
+    float u = (2.0 * (float(p.x) + 0.5) / size.x - 1.0) * pc.scale.x;
+    float v = (1.0 - 2.0 * (float(p.y) + 0.5) / size.y) * pc.scale.y;
+    Ray r = march(pc.frame.w, pc.from.xyz,
+                  normalize(pc.forward.xyz + u * pc.right.xyz + v * pc.up.xyz));
+    vec3 color = shade(r);
+    uint n = uint(pc.frame.x) * uint(pc.frame.y);
+    uint px = uint(p.y) * uint(pc.frame.x) + uint(p.x);
+    pixels[3u * px] = color.r;
+    pixels[3u * px + 1u] = color.g;
+    pixels[3u * px + 2u] = color.b;
+    pixels[3u * n + px] = float(r.steps);
+    pixels[4u * n + px] = float(r.crossings);
+    pixels[5u * n + px] = float(r.hit);
+    pixels[6u * n + px] = r.t;
+  }
+}
+#endif
+)glsl";
+
 }  // namespace
 
 std::string baked_params(const Tables<float>::KernelParams& p) {
@@ -82,21 +126,21 @@ std::string baked_params(const Tables<float>::KernelParams& p) {
          ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.background) + ");\n";
 }
 
-std::string baked_tables(const SceneTables<float>& tables) {
+std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays) {
   using Edge = Tables<float>::EdgeRecord;
   using Object = Tables<float>::ObjectRecord;
   const std::string zero4 = "vec4(0.0)", zeroi = "ivec4(0)";
   std::string s = "\n// The scene's tables, baked in.\n";
-  s += array("ivec4", "polygons", tables.polygons, zeroi, ivec4_literal);
+  s += array(constant_arrays, "ivec4", "polygons", tables.polygons, zeroi, ivec4_literal);
   s +=
-      array("EdgeRecord", "edges", tables.edges,
+      array(constant_arrays, "EdgeRecord", "edges", tables.edges,
             "EdgeRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi + ")",
             [](const Edge& e) {
               return "EdgeRecord(" + vec4_literal(e.segment) + ", " + vec4_literal(e.line) + ", " +
                      vec4_literal(e.map_linear) + ", " + vec4_literal(e.map_shift) + ", " +
                      ivec4_literal(e.link) + ")";
             });
-  s += array("ObjectRecord", "objects", tables.objects,
+  s += array(constant_arrays, "ObjectRecord", "objects", tables.objects,
              "ObjectRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi + ")",
              [](const Object& o) {
                return "ObjectRecord(" + vec4_literal(o.center) + ", " + vec4_literal(o.shape) +
@@ -107,6 +151,11 @@ std::string baked_tables(const SceneTables<float>& tables) {
 
 std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace) {
   return shader_source(tables.features, baked_tables(tables), trace) + kFragmentMain;
+}
+
+std::string scene_compute_shader(const SceneTables<float>& tables, bool trace) {
+  return shader_source(tables.features, baked_tables(tables, false), trace) + "\n#define TILE " +
+         std::to_string(kComputeTile) + "\n" + kComputeMain;
 }
 
 const char* const kFullScreenVertexShader = R"glsl(#version 450

@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include <glm/glm.hpp>
+
 #include "kernels/compile.hpp"
 
 namespace flatmarch::kernel {
@@ -14,7 +16,8 @@ namespace flatmarch::kernel {
 // compiler drop what this scene and these parameters never run (the other methods' code above
 // all): GPU compilers and llvmpipe run both sides of a branch that is not known to be uniform.
 // A change of parameters is a new program.
-std::string baked_tables(const SceneTables<float>& tables);
+// `constant_arrays`: declare the tables `const` (false: plain globals with the same initialisers).
+std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays = true);
 
 // Uniforms of the fragment shader (scene_fragment_shader):
 //   u_polygon, u_from         the camera's polygon and position
@@ -25,6 +28,29 @@ std::string baked_tables(const SceneTables<float>& tables);
 // With `trace` it marches one probe ray instead (u_polygon, u_from and the direction u_forward)
 // and writes its events to the event buffer (binding 4, see kernels/shader_prelude.glsl).
 std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace = false);
+
+// The compute shader of the Vulkan backend: the same kernel and tables, one invocation a pixel in
+// workgroups of kComputeTile x kComputeTile, over rows frame.z .. of the image (a band). Push
+// constants (ComputeConstants): the camera's position, basis and scale as above, and frame =
+// (width, height, first row, polygon). Output: buffer binding 5, `float pixels[]`, planar as
+// Frame's channels (row 0 at the top): the colour (3 floats a pixel), then the planes steps,
+// crossings, hit and t. The trace variant (one invocation) marches the ray from `from` along
+// `forward` in polygon frame.w and writes its events to binding 4 as the fragment shader's does.
+// Its tables are not `const` arrays but plain ones with the same initialisers: glslang gives a
+// dynamically indexed `const` array a function-local copy at each use (344 in the cube), which
+// lavapipe took 35 s to compile (the plain arrays: 2.4 s, and 0.3 s once SPIRV-Tools' optimiser
+// has run, which in turn made the `const` arrays' copies run 300x slower). Tables in buffers ran
+// 2-15x slower: their loads are not folded where the indices are constant.
+std::string scene_compute_shader(const SceneTables<float>& tables, bool trace = false);
+
+// The compute shader's push constants (std430: as laid out in C++).
+struct ComputeConstants {
+  glm::vec4 from, forward, right, up;  // xyz
+  glm::vec4 scale;                     // xy
+  glm::ivec4 frame;                    // width, height, first row, polygon
+};
+static_assert(sizeof(ComputeConstants) == 96);
+constexpr int kComputeTile = 8;
 
 // A full-screen triangle, the vertex shader that goes with it.
 extern const char* const kFullScreenVertexShader;

@@ -105,7 +105,7 @@ TEST(OpenGlShader, BakesTheTablesAndSpecialisesOnTheFeatures) {
 TEST(OpenGlShader, CompileErrorsShowTheGeneratedLinesAround) {
   const std::string source = "line one\nline two\nline three\nline four\nline five\n";
   const std::string log = "0:3(5): error: `three' undeclared\n0:1(1): warning: unused\n";
-  const std::string text = gl::annotate_log(source, log, 1);
+  const std::string text = kernel::annotate_log(source, log, 1);
   EXPECT_NE(text.find(">    3  line three"), std::string::npos) << text;
   EXPECT_NE(text.find("     2  line two"), std::string::npos) << text;
   EXPECT_NE(text.find("     4  line four"), std::string::npos) << text;
@@ -124,7 +124,7 @@ TEST(OpenGlShader, DriverErrorsNameTheBrokenLine) {
   try {
     opengl().compile(source);
     FAIL() << "a broken shader compiled";
-  } catch (const gl::ShaderError& e) {
+  } catch (const kernel::ShaderError& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_name"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find(">  "), std::string::npos) << e.what();
   }

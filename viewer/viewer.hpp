@@ -44,7 +44,7 @@ struct ViewerOptions {
 };
 
 // Opens the window and runs until it is closed, Esc is pressed with the cursor released, the
-// script ends or the frames are drawn. Throws Unavailable as above, gl::ShaderError for a
+// script ends or the frames are drawn. Throws Unavailable as above, kernel::ShaderError for a
 // kernel that does not compile, std::runtime_error for OpenGL errors and for screenshots and
 // state files that cannot be written.
 void run(const ViewerOptions& options);

@@ -1,44 +1,11 @@
 #include "backends/opengl/gl_kernel.hpp"
 
 #include <algorithm>
-#include <cstring>
-#include <regex>
-#include <set>
-#include <sstream>
 
 #include "backends/kernel_trace.hpp"
 #include "kernels/scene_shader.hpp"
 
 namespace flatmarch::gl {
-
-std::string annotate_log(const std::string& source, const std::string& log, int context) {
-  std::vector<std::string> lines;
-  std::istringstream in(source);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  // The lines errors name; the lines warnings name only when there is no error.
-  std::set<int> named, warned;
-  static const std::regex kLine(R"((?:^|\n)\s*\d+:(\d+)\(\d+\):\s*(\w+))");
-  for (auto it = std::sregex_iterator(log.begin(), log.end(), kLine); it != std::sregex_iterator();
-       ++it)
-    ((*it)[2] == "error" ? named : warned).insert(std::stoi((*it)[1]));
-  if (named.empty()) named = warned;
-  std::string out = log;
-  int shown_to = 0;  // the last line shown, so that nearby errors share their context
-  for (const int n : named) {
-    const int from = std::max({1, n - context, shown_to + 1});
-    const int to = std::min(static_cast<int>(lines.size()), n + context);
-    if (from > to) continue;
-    out += "\n  ...\n";
-    for (int k = from; k <= to; ++k) {
-      char number[16];
-      std::snprintf(number, sizeof number, "%5d", k);
-      out += std::string(k == n ? ">" : " ") + number + "  " + lines[static_cast<size_t>(k - 1)] +
-             "\n";
-    }
-    shown_to = to;
-  }
-  return out;
-}
 
 namespace {
 
@@ -55,8 +22,8 @@ GLuint compile(const Api& gl, GLenum stage, const std::string& source) {
   gl.GetShaderInfoLog(shader, length, nullptr, log.data());
   gl.DeleteShader(shader);
   log.resize(log.find('\0') == std::string::npos ? log.size() : log.find('\0'));
-  throw ShaderError(std::string(stage == GL_VERTEX_SHADER ? "vertex" : "fragment") +
-                    " shader does not compile:\n" + annotate_log(source, log));
+  throw kernel::ShaderError(std::string(stage == GL_VERTEX_SHADER ? "vertex" : "fragment") +
+                            " shader does not compile:\n" + kernel::annotate_log(source, log));
 }
 
 }  // namespace
@@ -83,7 +50,7 @@ GLuint link_program(const Api& gl, const std::string& vertex, const std::string&
   std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
   gl.GetProgramInfoLog(program, length, nullptr, log.data());
   gl.DeleteProgram(program);
-  throw ShaderError("the shader program does not link:\n" + log);
+  throw kernel::ShaderError("the shader program does not link:\n" + log);
 }
 
 RenderTargets::RenderTargets(const Api& gl, int width, int height)
@@ -151,23 +118,11 @@ void KernelProgram::draw(const CameraBasis<float>& c, int polygon, glm::vec3 fro
   gl_.DrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-namespace {
-// The event buffer's layout (kernels/shader_prelude.glsl, std430).
-struct EventHeader {
-  GLint count, max_events, steps, pad;
-};
-struct EventRecord {
-  GLint kind[4];
-  GLint more[4];
-  GLfloat at[4];
-};
-}  // namespace
-
 Trace KernelProgram::trace(const Ray& ray, int max_events) const {
   if (!trace_) throw std::logic_error("KernelProgram::trace needs a trace program");
   max_events = std::max(max_events, 0);
-  const size_t bytes = sizeof(EventHeader) + sizeof(EventRecord) * static_cast<size_t>(max_events);
-  const EventHeader header{0, max_events, 0, 0};
+  const size_t bytes = shader_trace_bytes(max_events);
+  const ShaderEventHeader header{0, max_events, 0, 0};
   gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, events_);
   gl_.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(bytes), nullptr,
                  GL_DYNAMIC_READ);
@@ -184,18 +139,7 @@ Trace KernelProgram::trace(const Ray& ray, int max_events) const {
   gl_.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   std::vector<unsigned char> data(bytes);
   gl_.GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(bytes), data.data());
-  EventHeader got;
-  std::memcpy(&got, data.data(), sizeof got);
-  std::vector<kernel::KernelEvent> events;
-  for (int k = 0; k < std::min(got.count, max_events); ++k) {
-    EventRecord e;
-    std::memcpy(&e,
-                data.data() + sizeof(EventHeader) + sizeof(EventRecord) * static_cast<size_t>(k),
-                sizeof e);
-    events.push_back({e.kind[0], e.kind[1], e.kind[2], e.kind[3], e.more[0], e.more[1],
-                      static_cast<double>(e.at[3]), glm::dvec3(e.at[0], e.at[1], e.at[2])});
-  }
-  return kernel_trace(events, got.steps);
+  return shader_trace(data.data(), max_events);
 }
 
 }  // namespace flatmarch::gl

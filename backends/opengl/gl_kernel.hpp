@@ -10,21 +10,11 @@
 #include "backends/opengl/gl_api.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/compile.hpp"
+#include "kernels/shader_log.hpp"
 
 namespace flatmarch::gl {
 
-// A shader that does not compile or link. what() has the driver's log and, for each line it
-// names, the generated source around it.
-class ShaderError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// The driver's log with the lines of `source` it refers to ("0:LINE(COLUMN): ..." as Mesa and
-// most drivers write them), `context` lines either side, numbered.
-std::string annotate_log(const std::string& source, const std::string& log, int context = 3);
-
-// Compiles and links; throws ShaderError.
+// Compiles and links; throws kernel::ShaderError.
 GLuint link_program(const Api& gl, const std::string& vertex, const std::string& fragment);
 
 // A framebuffer with two float colour targets of one size, bound for drawing while it lives:

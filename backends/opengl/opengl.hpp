@@ -30,7 +30,7 @@ class OpenGlBackend final : public Backend {
               int max_events) const override;
 
   // Compiles a fragment shader for this backend's program (with the full-screen vertex shader);
-  // throws gl::ShaderError with the driver's log and the source lines it names.
+  // throws kernel::ShaderError with the driver's log and the source lines it names.
   void compile(const std::string& fragment) const;
 
   // The OpenGL renderer and version of its context ("" when unavailable).

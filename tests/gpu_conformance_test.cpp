@@ -1,34 +1,47 @@
-// The OpenGL backend (headless, OSMesa) against the oracle and against the scalar backend, for
-// every gallery scene and method: the hit AOV agrees with the oracle on at least 99% of the
-// pixels of a 160x90 frame (the scalar backend's named out-of-steps exceptions aside), with the
-// scalar backend on at least 99.5%, and generic probe rays follow the oracle's events. Labelled
-// `conformance`: it checks results, not memory, so the sanitizer stage leaves it out. Skipped,
-// visibly, when OSMesa cannot give an OpenGL 4.5 context here.
+// The GPU backends, OpenGL (headless, OSMesa) and Vulkan (under the validation layer), against
+// the oracle and against the scalar backend, for every gallery scene and method: the hit AOV
+// agrees with the oracle on at least 99% of the pixels of a 160x90 frame (the scalar backend's
+// named out-of-steps exceptions aside), with the scalar backend on at least 99.5%, and generic
+// probe rays follow the oracle's events. Labelled `conformance`: it checks results, not memory,
+// so the sanitizer stage leaves it out. A backend that is unavailable here is skipped, visibly.
 #include <gtest/gtest.h>
 
 #include <iostream>
 #include <map>
 
-#include "backends/opengl/opengl.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "tests/gallery.hpp"
 #include "tests/opengl_backend.hpp"
 #include "tests/oracle_compare.hpp"
+#include "tests/vulkan_backend.hpp"
 
 namespace flatmarch {
 namespace {
 
-using test::opengl;
-
 struct Case {
+  std::string backend;  // opengl or vulkan
   std::string scene;
   Method method;
 };
 
-class OpenGlConformance : public testing::TestWithParam<Case> {};
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.backend << " " << c.scene << " " << to_string(c.method);
+}
 
-TEST_P(OpenGlConformance, HitAovAgreesWithTheOracleAndScalar) {
-  SKIP_WITHOUT_OPENGL();
+class GpuConformance : public testing::TestWithParam<Case> {
+ protected:
+  const Backend& backend() const {
+    if (GetParam().backend == "opengl") return test::opengl();
+    return test::vulkan();
+  }
+};
+
+#define SKIP_UNAVAILABLE()                                           \
+  if (const Availability a = backend().availability(); !a.available) \
+  GTEST_SKIP() << "the " << GetParam().backend << " backend is unavailable here: " << a.reason
+
+TEST_P(GpuConformance, HitAovAgreesWithTheOracleAndScalar) {
+  SKIP_UNAVAILABLE();
   const Scene& scene = test::gallery_scene(GetParam().scene);
   MarchParams params;
   params.method = GetParam().method;
@@ -36,11 +49,11 @@ TEST_P(OpenGlConformance, HitAovAgreesWithTheOracleAndScalar) {
   const Frame truth = OracleBackend().render(scene, scene.camera, kWidth, kHeight, {}, {});
   const std::vector<std::set<int>> answers = test::oracle_answers(scene, kWidth, kHeight);
   const Frame scalar = ScalarBackend().render(scene, scene.camera, kWidth, kHeight, params, {});
-  const Frame got = opengl().render(scene, scene.camera, kWidth, kHeight, params, {});
+  const Frame got = backend().render(scene, scene.camera, kWidth, kHeight, params, {});
   ASSERT_EQ(got.hit.size(), truth.hit.size());
   const double pixels = static_cast<double>(truth.hit.size());
   size_t acceptable = 0, gave_up = 0, same_as_scalar = 0, same_steps = 0;
-  std::map<std::pair<int, int>, int> confusion;  // (oracle's hit, opengl's hit) -> pixels
+  std::map<std::pair<int, int>, int> confusion;  // (oracle's hit, the backend's) -> pixels
   for (size_t px = 0; px < truth.hit.size(); ++px) {
     const int hit = static_cast<int>(got.hit[px]);
     const bool fine = answers[px].count(hit) > 0;
@@ -52,8 +65,9 @@ TEST_P(OpenGlConformance, HitAovAgreesWithTheOracleAndScalar) {
     EXPECT_LE(got.steps[px], static_cast<float>(params.max_steps));
   }
   const double fraction = static_cast<double>(acceptable) / pixels;
-  std::cout << "[ figures  ] " << scene.name << " " << to_string(params.method) << ": oracle "
-            << 100.0 * fraction << "% (ambiguous pixels allowed), scalar hit "
+  std::cout << "[ figures  ] " << GetParam().backend << " " << scene.name << " "
+            << to_string(params.method) << ": oracle " << 100.0 * fraction
+            << "% (ambiguous pixels allowed), scalar hit "
             << 100.0 * static_cast<double>(same_as_scalar) / pixels << "%, steps "
             << 100.0 * static_cast<double>(same_steps) / pixels << "%;";
   for (const auto& [hits, count] : confusion)
@@ -67,8 +81,8 @@ TEST_P(OpenGlConformance, HitAovAgreesWithTheOracleAndScalar) {
   }
 }
 
-TEST_P(OpenGlConformance, GenericRaysFollowTheOraclesEvents) {
-  SKIP_WITHOUT_OPENGL();
+TEST_P(GpuConformance, GenericRaysFollowTheOraclesEvents) {
+  SKIP_UNAVAILABLE();
   const Scene& scene = test::gallery_scene(GetParam().scene);
   const std::vector<Ray> rays = test::generic_rays(scene);
   ASSERT_EQ(static_cast<int>(rays.size()), test::kRaysPerScene);
@@ -76,7 +90,7 @@ TEST_P(OpenGlConformance, GenericRaysFollowTheOraclesEvents) {
   params.method = GetParam().method;
   for (size_t k = 0; k < rays.size(); ++k) {
     const Trace truth = OracleBackend().trace(scene, rays[k], {}, test::kEvents);
-    const Trace got = opengl().trace(scene, rays[k], params, test::kEvents);
+    const Trace got = backend().trace(scene, rays[k], params, test::kEvents);
     ASSERT_EQ(got.events.size(), truth.events.size()) << "ray " << k;
     for (size_t i = 0; i < truth.events.size(); ++i) {
       const Event &a = truth.events[i], &b = got.events[i];
@@ -93,14 +107,17 @@ TEST_P(OpenGlConformance, GenericRaysFollowTheOraclesEvents) {
 
 std::vector<Case> cases() {
   std::vector<Case> all;
-  for (const std::string& name : test::gallery_names())
-    for (Method m : {Method::sphere, Method::relaxed, Method::analytic}) all.push_back({name, m});
+  for (const char* backend : {"opengl", "vulkan"})
+    for (const std::string& name : test::gallery_names())
+      for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
+        all.push_back({backend, name, m});
   return all;
 }
 
-INSTANTIATE_TEST_SUITE_P(Gallery, OpenGlConformance, testing::ValuesIn(cases()),
+INSTANTIATE_TEST_SUITE_P(Gallery, GpuConformance, testing::ValuesIn(cases()),
                          [](const testing::TestParamInfo<Case>& param) {
-                           return param.param.scene + "_" + to_string(param.param.method);
+                           return param.param.backend + "_" + param.param.scene + "_" +
+                                  to_string(param.param.method);
                          });
 
 }  // namespace

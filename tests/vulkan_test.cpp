@@ -1,0 +1,294 @@
+// The Vulkan backend (lavapipe here, under the validation layer): the generated compute shader
+// and glslang's errors, traces, image orientation, buffers across frame sizes, progress, errors,
+// the validation layer's messages, a machine without a Vulkan driver, and the command line
+// (gpu_conformance_test holds it against the oracle on the gallery). Tests that need a device
+// skip, visibly, where there is none.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "backends/scalar/scalar.hpp"
+#include "backends/vulkan/spirv.hpp"
+#include "kernels/scene_shader.hpp"
+#include "kernels/shader_log.hpp"
+#include "tests/gallery.hpp"
+#include "tests/oracle_compare.hpp"
+#include "tests/process.hpp"
+#include "tests/vulkan_backend.hpp"
+
+namespace flatmarch {
+namespace {
+
+using test::vulkan;
+
+std::string scene_path(const std::string& name) {
+  return std::string(FLATMARCH_SOURCE_DIR) + "/scenes/" + name + ".json";
+}
+
+TEST(VulkanShader, EveryGallerySceneCompilesToSpirvWithGlslang) {
+  for (const std::string& name : test::gallery_names()) {
+    const kernel::SceneTables<float> tables =
+        kernel::compile_scene<float>(test::gallery_scene(name), {});
+    for (bool trace : {false, true}) {
+      const std::vector<uint32_t> spirv =
+          vulkan::compile_compute(kernel::scene_compute_shader(tables, trace));
+      ASSERT_GT(spirv.size(), 5u) << name;
+      EXPECT_EQ(spirv[0], 0x07230203u) << name << ": not a SPIR-V module";  // its magic number
+    }
+  }
+}
+
+TEST(VulkanShader, BakesTheTablesAsPlainArraysAndSpecialises) {
+  const Scene& scene = test::gallery_scene("cube");
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
+  const std::string source = kernel::scene_compute_shader(tables);
+  const std::string edges = "EdgeRecord edges[" + std::to_string(tables.edges.size()) + "]";
+  ASSERT_NE(source.find("\n" + edges), std::string::npos);
+  EXPECT_EQ(source.find("const " + edges), std::string::npos) << "see scene_compute_shader";
+  EXPECT_NE(source.find("const KernelParams params"), std::string::npos);
+  EXPECT_NE(source.find("const uint FEATURES = " + std::to_string(tables.features) + "u;"),
+            std::string::npos);
+  EXPECT_NE(source.find("layout(local_size_x = TILE, local_size_y = TILE) in;"), std::string::npos);
+  EXPECT_EQ(source.find("#define FLATMARCH_TRACE"), std::string::npos);
+  EXPECT_NE(kernel::scene_compute_shader(tables, true).find("#define FLATMARCH_TRACE"),
+            std::string::npos);
+}
+
+TEST(VulkanShader, GlslangErrorsNameTheBrokenLine) {
+  const Scene& scene = test::gallery_scene("torus");
+  std::string source = kernel::scene_compute_shader(kernel::compile_scene<float>(scene, {}));
+  const std::string call = "vec3 color = shade(r);";  // in the frame variant's main()
+  const size_t at = source.find(call);
+  ASSERT_NE(at, std::string::npos);
+  source.replace(at, call.size(), "vec3 color = shade(no_such_name);");
+  try {
+    vulkan::compile_compute(source);
+    FAIL() << "a broken shader compiled";
+  } catch (const kernel::ShaderError& e) {
+    const std::string text = e.what();
+    EXPECT_NE(text.find("'no_such_name' : undeclared identifier"), std::string::npos) << text;
+    EXPECT_NE(text.find("vec3 color = shade(no_such_name);"), std::string::npos) << text;
+    // The line glslang names is marked.
+    const size_t marked = text.find("\n>");
+    ASSERT_NE(marked, std::string::npos) << text;
+    EXPECT_NE(text.substr(marked, text.find('\n', marked + 1) - marked).find("no_such_name"),
+              std::string::npos)
+        << text;
+  }
+}
+
+TEST(Vulkan, TraceMatchesTheScalarKernelsSteps) {
+  SKIP_WITHOUT_VULKAN();
+  const Scene& scene = test::gallery_scene("l_shape");
+  MarchParams params;
+  params.method = Method::sphere;
+  for (const Ray& ray : test::generic_rays(scene)) {
+    const Trace a = ScalarBackend().trace(scene, ray, params, 50);
+    const Trace b = vulkan().trace(scene, ray, params, 50);
+    EXPECT_NEAR(b.steps, a.steps, 2);
+    ASSERT_EQ(b.events.size(), a.events.size());
+    for (size_t k = 0; k < a.events.size(); ++k)
+      EXPECT_EQ(test::describe(b.events[k]), test::describe(a.events[k]));
+  }
+}
+
+TEST(Vulkan, TraceKeepsAtMostMaxEventsAndCountsTheRest) {
+  SKIP_WITHOUT_VULKAN();
+  const Scene& scene = test::gallery_scene("torus");
+  const Ray ray = test::generic_rays(scene).front();
+  const Trace all = vulkan().trace(scene, ray, {}, 1000);
+  ASSERT_GT(all.events.size(), 3u);
+  const Trace cut = vulkan().trace(scene, ray, {}, 2);
+  ASSERT_EQ(cut.events.size(), 2u);
+  EXPECT_EQ(test::describe(cut.events[1]), test::describe(all.events[1]));
+  EXPECT_EQ(vulkan().trace(scene, ray, {}, 0).events.size(), 0u);
+}
+
+TEST(Vulkan, RefusesFloat64AndSaysWhy) {
+  SKIP_WITHOUT_VULKAN();
+  MarchParams params;
+  params.precision = Precision::f64;
+  const Scene& scene = test::gallery_scene("torus");
+  try {
+    vulkan().render(scene, scene.camera, 8, 8, params, {});
+    FAIL() << "rendered in f64";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("f32 only"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Vulkan, ReportsProgressInBandsToTheEnd) {
+  SKIP_WITHOUT_VULKAN();
+  const Scene& scene = test::gallery_scene("torus");
+  std::vector<double> seen;
+  vulkan().render(scene, scene.camera, 32, 200, {}, [&](double f) { seen.push_back(f); });
+  ASSERT_EQ(seen.size(), 4u);  // 200 rows in bands of 64
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+}
+
+// The hit AOV's pixels that differ from the scalar backend's.
+size_t differences(const Frame& a, const Frame& b) {
+  size_t n = 0;
+  for (size_t px = 0; px < a.hit.size(); ++px) n += a.hit[px] != b.hit[px];
+  return n;
+}
+
+TEST(Vulkan, ImageRowsAreTopDownAsDesignSays) {
+  SKIP_WITHOUT_VULKAN();
+  // The cube's bottom rows see the floor, its top rows the sky over the walls.
+  const Scene& scene = test::gallery_scene("cube");
+  Camera camera = scene.camera;
+  camera.pitch_deg = 0.0;
+  constexpr int kWidth = 40, kHeight = 30;
+  const Frame scalar = ScalarBackend().render(scene, camera, kWidth, kHeight, {}, {});
+  const Frame got = vulkan().render(scene, camera, kWidth, kHeight, {}, {});
+  size_t mirrored = 0;
+  for (int j = 0; j < kHeight; ++j)
+    for (int i = 0; i < kWidth; ++i)
+      mirrored += got.hit[got.pixel(i, j)] == scalar.hit[scalar.pixel(i, kHeight - 1 - j)];
+  EXPECT_LE(differences(got, scalar), 6u);
+  EXPECT_LT(mirrored, got.hit.size() / 2);  // the test would not see a flip otherwise
+}
+
+TEST(Vulkan, FramesOfEverySizeAgreeWithScalarAsBuffersGrow) {
+  SKIP_WITHOUT_VULKAN();
+  // Sizes that are not multiples of the 8x8 workgroups or of the 64-row bands, small after large
+  // (the pixel buffer is kept and grown): every pixel written, in its place, with every channel.
+  const Scene& scene = test::gallery_scene("mirror_square");
+  for (const auto& [w, h] : {std::pair{13, 7}, {97, 131}, {5, 3}, {64, 64}}) {
+    const Frame scalar = ScalarBackend().render(scene, scene.camera, w, h, {}, {});
+    const Frame got = vulkan().render(scene, scene.camera, w, h, {}, {});
+    ASSERT_EQ(got.hit.size(), static_cast<size_t>(w * h));
+    EXPECT_LE(differences(got, scalar), static_cast<size_t>(w * h) / 200 + 1) << w << "x" << h;
+    size_t steps = 0, colours = 0;
+    for (size_t px = 0; px < got.hit.size(); ++px) {
+      steps += got.steps[px] == scalar.steps[px] && got.crossings[px] == scalar.crossings[px];
+      colours += std::abs(got.rgb[3 * px + 1] - scalar.rgb[3 * px + 1]) < 1e-3f;
+    }
+    EXPECT_GE(steps, got.hit.size() * 99 / 100) << w << "x" << h;
+    EXPECT_GE(colours, got.hit.size() * 99 / 100) << w << "x" << h;
+  }
+}
+
+TEST(Vulkan, AValidationMessageFailsTheCallThatCausedIt) {
+  SKIP_WITHOUT_VULKAN();
+  ASSERT_TRUE(vulkan().validation());
+  // A shader that reads binding 7, which the backend's pipeline layout does not have: the
+  // validation layer says so when the pipeline is made.
+  const std::string source = R"glsl(#version 450
+layout(local_size_x = 1) in;
+layout(std430, binding = 7) buffer Missing { float values[]; };
+void main() { values[0] = 1.0; }
+)glsl";
+  const size_t before = vulkan::validation_messages().size();
+  try {
+    vulkan().compile(source);
+    FAIL() << "the validation layer's message was not reported";
+  } catch (const kernel::ShaderError& e) {
+    FAIL() << "glslang rejected the shader: " << e.what();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("validation layer"), std::string::npos) << e.what();
+  }
+  EXPECT_GT(vulkan::validation_messages().size(), before);
+}
+
+TEST(Vulkan, AWholeLifeUnderValidationIsSilent) {
+  const size_t before = vulkan::validation_messages().size();
+  {
+    BackendOptions options;
+    options.validation = true;
+    const VulkanBackend backend(options);
+    if (const Availability a = backend.availability(); !a.available)
+      GTEST_SKIP() << "the vulkan backend is unavailable here: " << a.reason;
+    const Scene& scene = test::gallery_scene("l_shape");
+    backend.render(scene, scene.camera, 40, 90, {}, {});
+    backend.trace(scene, test::generic_rays(scene).front(), {}, 10);
+  }  // the device and instance are destroyed here: leaks would be reported now
+  const std::vector<std::string> messages = vulkan::validation_messages();
+  for (size_t k = before; k < messages.size(); ++k) ADD_FAILURE() << messages[k];
+}
+
+TEST(VulkanCli, WithoutADriverTheBackendIsUnavailableAndSaysWhy) {
+  // The loader reads its drivers from VK_ICD_FILENAMES when set: here, none.
+  const std::vector<std::string> no_driver = {"env", "VK_ICD_FILENAMES=/nonexistent/icd.json",
+                                              "VK_DRIVER_FILES=/nonexistent/icd.json",
+                                              FLATMARCH_BINARY};
+  const auto with = [&](std::vector<std::string> args) {
+    std::vector<std::string> argv = no_driver;
+    argv.insert(argv.end(), args.begin(), args.end());
+    return test::run_process(argv);
+  };
+  const auto listed = with({"backends", "--json"});
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  bool found = false;
+  for (const auto& b : nlohmann::json::parse(listed.out))
+    if (b["name"] == "vulkan") {
+      found = true;
+      EXPECT_FALSE(b["available"].get<bool>());
+      EXPECT_NE(b["reason"].get<std::string>().find("no driver"), std::string::npos) << b;
+      EXPECT_TRUE(b["devices"].empty());
+    }
+  EXPECT_TRUE(found);
+  const auto rendered = with({"render", scene_path("torus"), "--backend", "vulkan", "--size", "8x8",
+                              "-o", test::make_temp_dir() + "/t.png"});
+  EXPECT_EQ(rendered.exit_code, 3) << rendered.err;
+  EXPECT_NE(rendered.err.find("backend vulkan is unavailable here"), std::string::npos)
+      << rendered.err;
+  const auto scalar = with({"render", scene_path("torus"), "--backend", "scalar", "--size", "8x8",
+                            "-o", test::make_temp_dir() + "/t.png"});
+  EXPECT_EQ(scalar.exit_code, 0) << scalar.err;
+}
+
+TEST(VulkanCli, DevicePicksByIndexOrNameAndAnUnknownOneExits3) {
+  SKIP_WITHOUT_VULKAN();
+  const auto listed = test::run_flatmarch({"backends", "--json"});
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  std::string name;
+  for (const auto& b : nlohmann::json::parse(listed.out))
+    if (b["name"] == "vulkan") {
+      ASSERT_FALSE(b["devices"].empty());
+      name = b["devices"][0]["name"].get<std::string>();
+    }
+  ASSERT_FALSE(name.empty());
+  const std::string dir = test::make_temp_dir();
+  for (const std::string& device : {std::string("0"), name.substr(0, 4)}) {
+    const auto r = test::run_flatmarch({"render", scene_path("l_shape"), "--backend", "vulkan",
+                                        "--device", device, "--method", "analytic", "--size",
+                                        "64x36", "-o", dir + "/l.png"});
+    EXPECT_EQ(r.exit_code, 0) << device << ": " << r.err;
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir + "/l.exr"));
+  const auto r = test::run_flatmarch({"render", scene_path("l_shape"), "--backend", "vulkan",
+                                      "--device", "no such device", "-o", dir + "/x.png"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("no Vulkan device matches --device \"no such device\""), std::string::npos)
+      << r.err;
+}
+
+TEST(VulkanCli, ShaderPrintsTheComputeShaderAndCompileReportsErrorsWithExit2) {
+  SKIP_WITHOUT_VULKAN();
+  const std::string scene = scene_path("torus");
+  const auto printed = test::run_flatmarch({"shader", scene, "--backend", "vulkan"});
+  ASSERT_EQ(printed.exit_code, 0) << printed.err;
+  EXPECT_EQ(printed.out.rfind("#version 450", 0), 0u);
+  EXPECT_NE(printed.out.find("layout(push_constant) uniform Constants"), std::string::npos);
+  const auto compiled = test::run_flatmarch({"shader", scene, "--backend", "vulkan", "--compile"});
+  EXPECT_EQ(compiled.exit_code, 0) << compiled.err;
+  EXPECT_NE(compiled.err.find("compiles"), std::string::npos);
+
+  const std::string file = test::make_temp_dir() + "/broken.comp";
+  std::string broken = printed.out;
+  broken.replace(broken.find("vec3 color = shade(r);"), 22, "vec3 color = shade(r, r);");
+  std::ofstream(file) << broken;
+  const auto failed =
+      test::run_flatmarch({"shader", scene, "--backend", "vulkan", "--compile", "--file", file});
+  EXPECT_EQ(failed.exit_code, 2);
+  EXPECT_NE(failed.err.find("error: " + file), std::string::npos) << failed.err;
+  EXPECT_NE(failed.err.find("vec3 color = shade(r, r);"), std::string::npos) << failed.err;
+}
+
+}  // namespace
+}  // namespace flatmarch
