@@ -13,6 +13,11 @@
 #include <optional>
 #include <stdexcept>
 
+#ifdef FLATMARCH_SANITIZE_BUILD
+#include <dlfcn.h>
+#include <link.h>
+#endif
+
 #include "backends/kernel_trace.hpp"
 #include "backends/vulkan/spirv.hpp"
 #include "kernels/camera.hpp"
@@ -72,6 +77,24 @@ void watch_exit() {
   static std::once_flag registered;
   std::call_once(registered, [] { std::atexit([] { exiting = true; }); });
 }
+
+#ifdef FLATMARCH_SANITIZE_BUILD
+// Sanitizer builds keep the Vulkan drivers and layers loaded once the loader has opened them:
+// the loader closes them when its instance is destroyed, and LeakSanitizer can then neither name
+// nor suppress (ci/lsan.supp) the allocations they keep for the life of the process.
+void keep_vulkan_libraries_loaded() {
+  std::vector<std::string> names;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, size_t, void* out) {
+        const std::string name = info->dlpi_name ? info->dlpi_name : "";
+        if (name.find("vulkan") != std::string::npos || name.find("VkLayer") != std::string::npos)
+          static_cast<std::vector<std::string>*>(out)->push_back(name);
+        return 0;
+      },
+      &names);
+  for (const std::string& name : names) dlopen(name.c_str(), RTLD_LAZY | RTLD_NOLOAD);
+}
+#endif
 
 bool env_validation() {
   const char* v = std::getenv("FLATMARCH_VULKAN_VALIDATION");
@@ -354,6 +377,9 @@ void VulkanBackend::make_context() const {
 
     const std::vector<vk::raii::PhysicalDevice> physical = c->instance.enumeratePhysicalDevices();
     watch_exit();  // the drivers and layers are loaded now
+#ifdef FLATMARCH_SANITIZE_BUILD
+    keep_vulkan_libraries_loaded();
+#endif
     for (size_t k = 0; k < physical.size(); ++k) {
       const vk::PhysicalDeviceProperties p = physical[k].getProperties();
       vulkan::Device d;
