@@ -221,7 +221,10 @@ struct VulkanBackend::Context {
   // Room for `bytes` of pixels (and as much staging), and the descriptor pointing at it.
   void reserve_pixels(vk::DeviceSize bytes) {
     if (pixels.size >= bytes) return;
-    const vk::DeviceSize size = std::max<vk::DeviceSize>(bytes, pixels.size + pixels.size / 2);
+    // Grown by half again at least (frames of growing sizes), within what one descriptor covers.
+    const vk::DeviceSize size = std::max<vk::DeviceSize>(
+        bytes,
+        std::min<vk::DeviceSize>(pixels.size + pixels.size / 2, limits.maxStorageBufferRange));
     const auto host = vk::MemoryPropertyFlagBits::eHostVisible |
                       vk::MemoryPropertyFlagBits::eHostCoherent |
                       vk::MemoryPropertyFlagBits::eHostCached;
