@@ -90,7 +90,7 @@ void main() {
 }
 #else
 layout(local_size_x = TILE, local_size_y = TILE) in;
-layout(std430, binding = 5) writeonly buffer Pixels { float pixels[]; };
+layout(std430, binding = 5) writeonly buffer Pixels { vec4 pixels[]; };
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, pc.frame.z);
   if (p.x < pc.frame.x && p.y < pc.frame.y) {
@@ -102,13 +102,8 @@ void main() {
     vec3 color = shade(r);
     uint n = uint(pc.frame.x) * uint(pc.frame.y);
     uint px = uint(p.y) * uint(pc.frame.x) + uint(p.x);
-    pixels[3u * px] = color.r;
-    pixels[3u * px + 1u] = color.g;
-    pixels[3u * px + 2u] = color.b;
-    pixels[3u * n + px] = float(r.steps);
-    pixels[4u * n + px] = float(r.crossings);
-    pixels[5u * n + px] = float(r.hit);
-    pixels[6u * n + px] = r.t;
+    pixels[px] = vec4(color, 1.0);
+    pixels[n + px] = vec4(float(r.steps), float(r.crossings), float(r.hit), r.t);
   }
 }
 #endif

@@ -37,8 +37,8 @@ constexpr uint64_t kBandTimeoutNs = 120'000'000'000;
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 // The storage buffers of kernels/scene_shader.hpp.
 constexpr uint32_t kEventsBinding = 4, kPixelsBinding = 5;
-// Channels of the pixel buffer: colour (3), steps, crossings, hit, t.
-constexpr size_t kChannels = 7;
+// Floats a pixel in the pixel buffer: colour (rgb, 1), then the AOVs (steps, crossings, hit, t).
+constexpr size_t kChannels = 8;
 
 std::mutex& messages_mutex() {
   static std::mutex m;
@@ -624,11 +624,17 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
   const auto* planes =
       static_cast<const float*>(c.read_directly ? c.pixels.mapped : c.staging.mapped);
   const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
-  std::memcpy(frame.rgb.data(), planes, 3 * n * sizeof(float));
-  std::memcpy(frame.steps.data(), planes + 3 * n, n * sizeof(float));
-  std::memcpy(frame.crossings.data(), planes + 4 * n, n * sizeof(float));
-  std::memcpy(frame.hit.data(), planes + 5 * n, n * sizeof(float));
-  std::memcpy(frame.t.data(), planes + 6 * n, n * sizeof(float));
+  for (size_t px = 0; px < n; ++px) {
+    const float* col = planes + 4 * px;
+    const float* a = planes + 4 * (n + px);
+    frame.rgb[3 * px] = col[0];
+    frame.rgb[3 * px + 1] = col[1];
+    frame.rgb[3 * px + 2] = col[2];
+    frame.steps[px] = a[0];
+    frame.crossings[px] = a[1];
+    frame.hit[px] = a[2];
+    frame.t[px] = a[3];
+  }
   check.done();
   return frame;
 }

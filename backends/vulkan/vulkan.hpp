@@ -1,7 +1,7 @@
 // The Vulkan backend: the kernel as a compute shader (kernels/scene_shader.hpp), specialised per
 // scene with its tables baked in, compiled to SPIR-V with glslang at run time, on any Vulkan
 // device: a GPU where there is one, Mesa's lavapipe (on the CPU) where there is none. Colour and
-// the AOVs are written to a storage buffer, planar as the frame's channels, and read back.
+// the AOVs are written to a storage buffer and read back.
 // Float32 only.
 #pragma once
 
