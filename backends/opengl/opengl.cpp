@@ -9,6 +9,7 @@
 
 #include "backends/opengl/gl_api.hpp"
 #include "backends/opengl/gl_kernel.hpp"
+#include "backends/process_exit.hpp"
 #include "kernels/scene_shader.hpp"
 
 namespace flatmarch {
@@ -108,9 +109,12 @@ void OpenGlBackend::make_context() const {
   c->renderer = text(GL_RENDERER) + ", " + text(GL_VERSION);
   c->gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &c->max_size);
   context_ = std::move(c);
+  driver_loaded();  // after the driver has made its context, threads and exit handlers
 }
 
-OpenGlBackend::~OpenGlBackend() = default;
+OpenGlBackend::~OpenGlBackend() {
+  release_context(context_);
+}
 
 namespace {
 [[noreturn]] void unavailable(const std::string& why) {

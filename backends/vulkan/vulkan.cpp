@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +18,7 @@
 #endif
 
 #include "backends/kernel_trace.hpp"
+#include "backends/process_exit.hpp"
 #include "backends/vulkan/spirv.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/scene_shader.hpp"
@@ -63,19 +63,6 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
 size_t message_count() {
   const std::lock_guard<std::mutex> lock(messages_mutex());
   return messages().size();
-}
-
-// Set by an exit handler registered once Vulkan's libraries are loaded, so that it runs before
-// their own exit handlers: a backend destroyed after it (a static one) leaves its device to the
-// operating system, as the driver and layers may already be torn down.
-std::atomic<bool> exiting{false};
-std::vector<void*>& left_at_exit() {  // reachable, so that a leak checker does not report them
-  static auto* kept = new std::vector<void*>;
-  return *kept;
-}
-void watch_exit() {
-  static std::once_flag registered;
-  std::call_once(registered, [] { std::atexit([] { exiting = true; }); });
 }
 
 #ifdef FLATMARCH_SANITIZE_BUILD
@@ -318,7 +305,7 @@ VulkanBackend::VulkanBackend(const BackendOptions& options)
     : options_(options), validation_(options.validation || env_validation()) {}
 
 VulkanBackend::~VulkanBackend() {
-  if (exiting) left_at_exit().push_back(context_.release());
+  release_context(context_);
 }
 
 // The instance and device are made on first use, not when the backend is listed: every command
@@ -379,7 +366,7 @@ void VulkanBackend::make_context() const {
     if (validation_) c->messenger = c->instance.createDebugUtilsMessengerEXT(messenger_info);
 
     const std::vector<vk::raii::PhysicalDevice> physical = c->instance.enumeratePhysicalDevices();
-    watch_exit();  // the drivers and layers are loaded now
+    driver_loaded();  // the drivers and layers are loaded now (and again once the device is made)
 #ifdef FLATMARCH_SANITIZE_BUILD
     keep_vulkan_libraries_loaded();
 #endif
@@ -483,6 +470,7 @@ void VulkanBackend::make_context() const {
     c->reserve_events(shader_trace_bytes(64));
     c->reserve_pixels(64 * 64 * kChannels * sizeof(float));
     context_ = std::move(c);
+    driver_loaded();  // after the driver has made its device, threads and exit handlers
   } catch (const vk::SystemError& e) {
     unavailable_ = reason(e);
   } catch (const std::exception& e) {
