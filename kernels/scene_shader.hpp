@@ -41,7 +41,7 @@ std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace =
 // dynamically indexed `const` array a function-local copy at each use (344 in the cube), which
 // lavapipe took 35 s to compile (the plain arrays: 2.4 s, and 0.3 s once SPIRV-Tools' optimiser
 // has run, which in turn made the `const` arrays' copies run 300x slower). Tables in buffers ran
-// 2-15x slower: their loads are not folded where the indices are constant.
+// 1.4-15x slower: their loads are not folded where the indices are constant.
 std::string scene_compute_shader(const SceneTables<float>& tables, bool trace = false);
 
 // The compute shader's push constants (std430: as laid out in C++).
