@@ -14,5 +14,6 @@ void add_plan(CLI::App& app);
 void add_import_peer(CLI::App& app);
 void add_shader(CLI::App& app);
 void add_view(CLI::App& app);
+void add_conform(CLI::App& app);
 
 }  // namespace flatmarch::cli

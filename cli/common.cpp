@@ -96,6 +96,23 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
                  "lists them (default: a discrete GPU, else an integrated one, else the CPU)");
 }
 
+void check_march_params(const MarchParams& params) {
+  if (!(params.eps > 0.0) || !std::isfinite(params.eps))
+    throw UsageError("--eps: must be a positive number");
+  if (!(params.offset > 0.0) || !std::isfinite(params.offset))
+    throw UsageError("--offset: must be a positive number");
+  if (params.max_steps < 1 || params.max_steps > 100'000'000)
+    throw UsageError("--max-steps: must lie in [1, 1e8]");
+  if (!(params.max_distance > 0.0) || !std::isfinite(params.max_distance))
+    throw UsageError("--max-distance: must be a positive number");
+  if (!(params.omega >= 1.0 && params.omega < 2.0)) throw UsageError("--omega: must lie in [1, 2)");
+  if ((params.method == Method::sphere || params.method == Method::relaxed) &&
+      params.offset <= params.eps)
+    std::cerr << "warning: --offset " << params.offset << " is not above --eps " << params.eps
+              << ": a ray placed that close to the edge it came through crosses back, so every "
+                 "ray that reaches a gluing ends with max_steps\n";
+}
+
 const Backend& MarchOptions::resolve() {
   if (backend.empty()) {
     const Backend* preferred = find_backend(default_backend);
@@ -138,20 +155,7 @@ const Backend& MarchOptions::resolve() {
   const std::vector<Precision> precisions = b->precisions();
   if (std::find(precisions.begin(), precisions.end(), params.precision) == precisions.end())
     throw UsageError("--precision: backend " + backend + " does not march in " + precision);
-  if (!(params.eps > 0.0) || !std::isfinite(params.eps))
-    throw UsageError("--eps: must be a positive number");
-  if (!(params.offset > 0.0) || !std::isfinite(params.offset))
-    throw UsageError("--offset: must be a positive number");
-  if (params.max_steps < 1 || params.max_steps > 100'000'000)
-    throw UsageError("--max-steps: must lie in [1, 1e8]");
-  if (!(params.max_distance > 0.0) || !std::isfinite(params.max_distance))
-    throw UsageError("--max-distance: must be a positive number");
-  if (!(params.omega >= 1.0 && params.omega < 2.0)) throw UsageError("--omega: must lie in [1, 2)");
-  if ((params.method == Method::sphere || params.method == Method::relaxed) &&
-      params.offset <= params.eps)
-    std::cerr << "warning: --offset " << params.offset << " is not above --eps " << params.eps
-              << ": a ray placed that close to the edge it came through crosses back, so every "
-                 "ray that reaches a gluing ends with max_steps\n";
+  check_march_params(params);
   return *b;
 }
 

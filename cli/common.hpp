@@ -24,8 +24,17 @@ class UnavailableError : public std::runtime_error {
   explicit UnavailableError(const std::string& what) : std::runtime_error("error: " + what) {}
 };
 
+// Cases of `flatmarch conform` failed their thresholds: exit code 1.
+class ConformanceFailure : public std::runtime_error {
+ public:
+  explicit ConformanceFailure(const std::string& what) : std::runtime_error("error: " + what) {}
+};
+
 Vec3 parse_vec3(const std::string& option, const std::string& text);
 std::pair<int, int> parse_size(const std::string& option, const std::string& text);
+
+// Throws UsageError for parameters out of range; warns (stderr) when offset <= eps.
+void check_march_params(const MarchParams& params);
 
 // The backend and march parameters of render and trace (DESIGN.md section 3).
 struct MarchOptions {

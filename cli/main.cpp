@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   cli::add_import_peer(app);
   cli::add_shader(app);
   cli::add_view(app);
+  cli::add_conform(app);
   // CLI11 would only say that a subcommand is required.
   const auto subcommands = app.get_subcommands([](const CLI::App*) { return true; });
   const auto known = [&](const char* name) {
@@ -53,6 +54,9 @@ int main(int argc, char** argv) {
   } catch (const cli::UsageError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
+  } catch (const cli::ConformanceFailure& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 1;
   } catch (const cli::UnavailableError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 3;

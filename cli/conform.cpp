@@ -1,0 +1,187 @@
+// `flatmarch conform`: the conformance suite from the command line.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "cli/commands.hpp"
+#include "cli/common.hpp"
+#include "conformance/suite.hpp"
+#include "scene/load.hpp"
+
+namespace flatmarch::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A scene named by a file, or by its name in the gallery folder.
+fs::path scene_file(const std::string& name, const fs::path& gallery) {
+  if (fs::exists(name)) return name;
+  const fs::path in_gallery = gallery / (name + ".json");
+  if (fs::exists(in_gallery)) return in_gallery;
+  throw UsageError("--scene: no scene file \"" + name + "\" and no " + in_gallery.string());
+}
+
+std::string percent(double share) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%.3f", 100.0 * share);
+  return s;
+}
+
+std::string failures_summary(const conformance::CaseResult& r) {
+  std::string s;
+  for (int c = 0; c < conformance::kFailureClasses; ++c) {
+    const size_t n =
+        r.aov.failures[static_cast<size_t>(c)] + r.trace_failures[static_cast<size_t>(c)];
+    if (n)
+      s += (s.empty() ? "" : " ") + std::string(to_string(static_cast<conformance::Failure>(c))) +
+           ":" + std::to_string(n);
+  }
+  return s.empty() ? "-" : s;
+}
+
+}  // namespace
+
+void add_conform(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "conform",
+      "Measure backends against the oracle: for each backend, scene and method, a frame's hit and\n"
+      "crossings AOVs on the pixels the oracle can decide at this precision (the others are\n"
+      "reported apart as ambiguous), its colour (idiff-style thresholds and Yee's perceptual\n"
+      "metric), its step counts against the scalar backend in float64, and the traces of generic\n"
+      "probe rays; failures are classed (stuck, wrong_edge, missed_object, phantom_hit,\n"
+      "early_escape, late_escape, leak). Each case is judged by conformance/thresholds.json.\n"
+      "Prints a table, writes JSON; exits 1 when a case fails.");
+  struct Options {
+    std::vector<std::string> backends, scenes, methods;
+    std::string gallery = "scenes", size = "160x90", json = "conform.json", thresholds;
+    std::string precision = "f32";
+    MarchParams params;
+    BackendOptions backend_options;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("--backend", o->backends,
+                  "Backend to measure (repeat for more; default: every kernel backend, those "
+                  "unavailable here skipped with the reason)");
+  cmd->add_option("--scene", o->scenes,
+                  "Scene file, or a scene's name in the gallery folder (repeat; default: the "
+                  "whole gallery)");
+  cmd->add_option("--method", o->methods,
+                  "sphere, relaxed or analytic (repeat; default: all three)");
+  cmd->add_option("--gallery", o->gallery, "The gallery folder")->capture_default_str();
+  cmd->add_option("--size", o->size, "Frame size WxH")->capture_default_str();
+  cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
+  cmd->add_option("--thresholds", o->thresholds,
+                  "Thresholds file (default: conformance/thresholds.json as built in)");
+  cmd->add_option("--eps", o->params.eps, "Hit threshold")->capture_default_str();
+  cmd->add_option("--offset", o->params.offset, "Re-entry push after a gluing")
+      ->capture_default_str();
+  cmd->add_option("--max-steps", o->params.max_steps, "Kernel iterations before a ray gives up")
+      ->capture_default_str();
+  cmd->add_option("--max-distance", o->params.max_distance, "Path length before a ray gives up")
+      ->capture_default_str();
+  cmd->add_option("--omega", o->params.omega, "Over-relaxation factor of the relaxed method")
+      ->capture_default_str();
+  cmd->add_option("--precision", o->precision, "f32 or f64 (backends without f64 are skipped)")
+      ->capture_default_str();
+  cmd->add_option("--isa", o->backend_options.isa, "simd: the instruction set");
+  cmd->add_option("--threads", o->backend_options.threads, "simd: worker threads (0: all cores)");
+  cmd->add_option("--device", o->backend_options.device, "vulkan: the device");
+  cmd->add_flag("-q,--quiet", o->quiet, "Only the summary line");
+  cmd->callback([o] {
+    const auto [w, h] = parse_size("--size", o->size);
+    check_march_params(o->params);
+    if (o->precision == "f64")
+      o->params.precision = Precision::f64;
+    else if (o->precision != "f32")
+      throw UsageError("--precision: expected f32 or f64, got \"" + o->precision + "\"");
+    std::vector<Method> methods;
+    for (const std::string& name : o->methods) {
+      const auto m = parse_method(name);
+      if (!m || *m == Method::oracle)
+        throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + name + "\"");
+      methods.push_back(*m);
+    }
+    if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
+    std::vector<fs::path> files;
+    for (const std::string& s : o->scenes) files.push_back(scene_file(s, o->gallery));
+    if (files.empty()) {
+      if (!fs::is_directory(o->gallery))
+        throw UsageError("--gallery: no folder " + o->gallery + " (give --scene or --gallery)");
+      for (const auto& entry : fs::directory_iterator(o->gallery))
+        if (entry.path().extension() == ".json") files.push_back(entry.path());
+      std::sort(files.begin(), files.end());
+    }
+    std::vector<Scene> scenes;
+    for (const fs::path& f : files) scenes.push_back(load_scene(f));
+    if (o->backends.empty()) o->backends = {"scalar", "simd", "opengl", "vulkan"};
+    nlohmann::json thresholds = conformance::builtin_thresholds();
+    if (!o->thresholds.empty()) {
+      try {
+        thresholds = conformance::load_thresholds(o->thresholds);
+      } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--thresholds: ") + e.what());
+      }
+    }
+
+    conformance::Suite suite(thresholds);
+    nlohmann::json out = {{"cases", nlohmann::json::array()}, {"skipped", nlohmann::json::array()}};
+    int cases = 0, failed = 0;
+    if (!o->quiet)
+      std::printf("%-8s %-30s %-9s %7s %8s %8s %7s %7s %6s  %-24s %s\n", "backend", "scene",
+                  "method", "ambig%", "hit%", "cross%", "img%", "stepKS", "traces", "failures",
+                  "verdict");
+    for (const std::string& name : o->backends) {
+      if (name == "oracle")
+        throw UsageError("--backend: the oracle is what the others are measured against");
+      const std::unique_ptr<Backend> backend = make_backend(name, o->backend_options);
+      if (!backend)
+        throw UsageError("--backend: unknown backend \"" + name + "\" (see `flatmarch backends`)");
+      const Availability a = backend->availability();
+      const std::vector<Precision> precisions = backend->precisions();
+      std::string skip = a.available ? "" : "unavailable here: " + a.reason;
+      if (skip.empty() &&
+          std::find(precisions.begin(), precisions.end(), o->params.precision) == precisions.end())
+        skip = "does not march in " + o->precision;
+      if (!skip.empty()) {
+        std::printf("%-8s skipped: %s\n", name.c_str(), skip.c_str());
+        out["skipped"].push_back({{"backend", name}, {"reason", skip}});
+        continue;
+      }
+      for (const Scene& scene : scenes)
+        for (const Method m : methods) {
+          MarchParams params = o->params;
+          params.method = m;
+          const conformance::CaseResult r = suite.run(*backend, scene, params, w, h);
+          ++cases;
+          failed += !r.passed;
+          out["cases"].push_back(conformance::to_json(r));
+          if (o->quiet) continue;
+          int diverged = 0;
+          for (const auto& t : r.traces) diverged += t.failure.has_value();
+          std::printf(
+              "%-8s %-30s %-9s %7s %8s %8s %7s %7.3f %3d/%-2zu  %-24s %s\n", name.c_str(),
+              scene.name.c_str(), to_string(m),
+              percent(static_cast<double>(r.aov.ambiguous) / static_cast<double>(r.aov.pixels))
+                  .c_str(),
+              percent(r.aov.hit_rate()).c_str(), percent(r.aov.crossings_rate()).c_str(),
+              percent(static_cast<double>(r.image.fail) / static_cast<double>(r.image.pixels))
+                  .c_str(),
+              r.steps_ks, diverged, r.traces.size(), failures_summary(r).c_str(),
+              r.passed ? "pass" : "FAIL");
+          for (const std::string& line : r.failed_checks()) std::printf("    %s\n", line.c_str());
+          std::fflush(stdout);
+        }
+    }
+    std::ofstream(o->json) << out.dump(1) << "\n";
+    std::printf("%d cases, %d passed, %d failed; wrote %s\n", cases, cases - failed, failed,
+                o->json.c_str());
+    if (failed)
+      throw ConformanceFailure(std::to_string(failed) + " of " + std::to_string(cases) +
+                               " cases failed");
+  });
+}
+
+}  // namespace flatmarch::cli

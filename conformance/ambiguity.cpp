@@ -1,0 +1,203 @@
+#include "conformance/ambiguity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include <tbb/parallel_for.h>
+
+#include "backends/oracle/intersect.hpp"
+#include "kernels/camera.hpp"
+
+namespace flatmarch::conformance {
+
+namespace {
+
+// The oracle follows rays much further than a kernel's max_steps would let it (one of its steps
+// is a whole room), bounded still.
+constexpr int kTruthMaxSteps = 100000;
+
+double unit_roundoff(Precision p) {
+  return p == Precision::f32 ? 0x1p-24 : 0x1p-53;
+}
+
+// Where object or vertex marker `index` of room `p` (numbered as in the hit AOV) meets the line
+// o + s d for s in [0, limit] first, as the oracle intersects them.
+std::optional<SolidHit> meet(const Scene& scene, int p, int index, Vec3 o, Vec3 d, double limit) {
+  const int objects = static_cast<int>(scene.objects.size());
+  if (index < objects)
+    return intersect(scene.objects[static_cast<size_t>(index)], o, d, 0.0, limit);
+  const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
+  const double top = scene.period ? *scene.period : scene.height;
+  std::optional<SolidHit> first;
+  for (int v = 0; v < polygon.size(); ++v)
+    if (scene.marker_at(p, v) == index - objects)
+      if (auto hit = intersect_cylinder(polygon.vertex(v),
+                                        scene.markers[static_cast<size_t>(index - objects)].radius,
+                                        0.0, top, o, d, 0.0, limit))
+        if (!first || hit->t < first->t) first = hit;
+  return first;
+}
+
+// The objects and markers that can be met in room p, by their hit index.
+std::vector<int> solids_in(const Scene& scene, int p) {
+  std::vector<int> found;
+  for (size_t k = 0; k < scene.objects.size(); ++k)
+    if (scene.objects[k].polygon == p) found.push_back(static_cast<int>(k));
+  const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
+  for (int v = 0; v < polygon.size(); ++v)
+    if (const int m = scene.marker_at(p, v); m >= 0) {
+      const int index = static_cast<int>(scene.objects.size()) + m;
+      if (std::find(found.begin(), found.end(), index) == found.end()) found.push_back(index);
+    }
+  return found;
+}
+
+// The ambiguity of one room segment of the exact path, at `delta` (grown with the crossings so
+// far); `last` and `end` say whether and how the path ends with it, `crease` is the width over
+// which the kernel's normal (a finite difference) blurs an edge of a solid.
+uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last, const RayEnd& end,
+                          double delta, double crease) {
+  const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
+  const Vec2 from(seg.from), to(seg.to);
+  const double on = 1e-9 * scene.scale;  // a point this close to an edge lies on it
+  if (!scene.in_band(seg.from.z))  // entering from above or below: near the polygon's outline?
+    return polygon.distance_to_boundary(to) < delta ? kBandEdge : 0;
+
+  uint8_t bits = 0;
+  bool ends_on_edge = false;
+  for (int v = 0; v < polygon.size(); ++v) {
+    const Vec2 a = polygon.vertex(v), b = polygon.vertex(v + 1);
+    if (distance_to_segment(a, from, to) < delta) bits |= kNearVertex;
+    // Two segments that do not cross come closest at an end of one of them: the edge's ends are
+    // the vertices; the path's ends count unless they lie on this edge.
+    for (const Vec2 q : {from, to}) {
+      const double d = distance_to_segment(q, a, b);
+      if (d >= on && d < delta) bits |= kNearEdge;
+    }
+    ends_on_edge |= distance_to_segment(to, a, b) < on;
+  }
+  if (!scene.period) {
+    const bool at_band = std::abs(seg.to.z) < on || std::abs(seg.to.z - scene.height) < on;
+    if (ends_on_edge && (seg.to.z < delta || scene.height - seg.to.z < delta)) bits |= kBandEdge;
+    if (at_band && !ends_on_edge && polygon.distance_to_boundary(to) < delta) bits |= kBandEdge;
+  }
+
+  const Vec3 step = seg.to - seg.from;
+  const double length = glm::length(step);
+  if (length == 0.0) return bits;
+  const Vec3 d = step / length;
+  Vec3 e1 = glm::cross(d, Vec3(0.0, 0.0, 1.0));
+  if (glm::length(e1) < 1e-6) e1 = Vec3(1.0, 0.0, 0.0);
+  e1 = glm::normalize(e1);
+  const Vec3 e2 = glm::cross(d, e1);
+  for (const int index : solids_in(scene, seg.polygon)) {
+    const bool exact = last && end.hit == index;
+    // A shifted line meets a solid where the surface has moved away: further on where the ray
+    // hits it, within the room (and delta) where it does not.
+    const double limit = length + delta + (exact ? scene.scale : 0.0);
+    for (const Vec3 shift : {e1, -e1, e2, -e2})
+      if (meet(scene, seg.polygon, index, seg.from + delta * shift, d, limit).has_value() !=
+          exact) {
+        bits |= kSilhouette;
+        break;
+      }
+    // At an edge of the solid the normal, and so the colour, jumps: a hit within the kernel's
+    // normal step of one is a crease.
+    if (!exact || (bits & kSilhouette)) continue;
+    // On a smooth surface the normals a shift to either side finds differ from this one by as
+    // much; across an edge one side jumps.
+    const double reach = std::max(delta, crease);
+    for (const Vec3 axis : {e1, e2}) {
+      const auto plus = meet(scene, seg.polygon, index, seg.from + reach * axis, d, limit);
+      const auto minus = meet(scene, seg.polygon, index, seg.from - reach * axis, d, limit);
+      if (!plus || !minus ||
+          std::abs(glm::length(plus->normal - end.normal) -
+                   glm::length(minus->normal - end.normal)) > 0.1) {
+        bits |= kCrease;
+        break;
+      }
+    }
+  }
+  return bits;
+}
+
+}  // namespace
+
+double ambiguity_delta(const Scene& scene, const MarchParams& params) {
+  return params.eps + params.offset + 16.0 * unit_roundoff(params.precision) * scene.scale;
+}
+
+RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params, double delta) {
+  MarchParams exact;
+  exact.method = Method::oracle;
+  exact.max_distance = params.max_distance;
+  exact.max_steps = kTruthMaxSteps;
+  const OracleResult r = oracle_trace(scene, ray, exact, {.record_path = true});
+  RayTruth truth{r.end, 0};
+  if (r.end.hit == kHitVertex) truth.ambiguity |= kNearVertex;
+  const double crease = 1.5 * std::cbrt(unit_roundoff(params.precision)) * scene.scale;
+  const double on = 1e-9 * scene.scale;
+  // At a crossing the kernel places its point `offset` inside the new room, from wherever within
+  // eps of the edge it stopped: the ray moves (eps + offset) sin(angle) sideways, the angle
+  // between the ray and the edge's normal. The drifts add up, as they may in the worst case.
+  double drift = delta;
+  int crossings = 0;
+  for (size_t k = 0; k < r.path.size(); ++k) {
+    const PathSegment& seg = r.path[k];
+    const bool last = k + 1 == r.path.size();
+    truth.ambiguity |= segment_ambiguity(scene, seg, last, r.end, drift, crease);
+    if (last || !scene.in_band(seg.from.z)) continue;
+    const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
+    for (int e = 0; e < polygon.size(); ++e)
+      if (distance_to_segment(Vec2(seg.to), polygon.vertex(e), polygon.vertex(e + 1)) < on) {
+        const Vec3 step = seg.to - seg.from;
+        const double length = glm::length(step);
+        const Vec3 n(polygon.edges[static_cast<size_t>(e)].normal, 0.0);
+        const double along = length > 0.0 ? glm::dot(n, step) / length : 0.0;
+        drift += (params.eps + params.offset) * std::sqrt(std::max(0.0, 1.0 - along * along)) +
+                 16.0 * unit_roundoff(params.precision) * scene.scale;
+        ++crossings;
+        break;
+      }
+  }
+  // t is summed step by step: in float32 it drifts by about 2^-24 of the distance a step. A ray
+  // whose end lies that close to max_distance, on either side, may end either way.
+  const double slack = drift + (params.eps + params.offset) * static_cast<double>(crossings) +
+                       64.0 * unit_roundoff(params.precision) * params.max_distance;
+  if (r.end.hit == kHitMaxDistance) {
+    exact.max_distance = params.max_distance + slack;
+    if (oracle_trace(scene, ray, exact).end.hit != kHitMaxDistance)
+      truth.ambiguity |= kNearDistance;
+  } else if (r.end.t > params.max_distance - slack) {
+    truth.ambiguity |= kNearDistance;
+  }
+  return truth;
+}
+
+size_t FrameTruth::ambiguous() const {
+  return static_cast<size_t>(
+      std::count_if(ambiguity.begin(), ambiguity.end(), [](uint8_t a) { return a != 0; }));
+}
+
+FrameTruth frame_truth(const Scene& scene, const Camera& camera, int width, int height,
+                       const MarchParams& params) {
+  FrameTruth truth;
+  truth.frame = Frame(width, height);
+  truth.ambiguity.assign(static_cast<size_t>(width) * static_cast<size_t>(height), 0);
+  truth.delta = ambiguity_delta(scene, params);
+  const CameraBasis<double> basis =
+      camera_basis(camera.yaw_deg, camera.pitch_deg, camera.fov_deg, width, height);
+  tbb::parallel_for(0, height, [&](int j) {
+    for (int i = 0; i < width; ++i) {
+      const Ray ray{camera.polygon, camera.position, camera_ray(basis, i, j, width, height)};
+      const RayTruth r = ray_truth(scene, ray, params, truth.delta);
+      truth.frame.set(i, j, oracle_color(scene, r.end), r.end.steps, r.end.crossings, r.end.hit,
+                      r.end.t);
+      truth.ambiguity[truth.frame.pixel(i, j)] = r.ambiguity;
+    }
+  });
+  return truth;
+}
+
+}  // namespace flatmarch::conformance

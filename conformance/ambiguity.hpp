@@ -1,0 +1,61 @@
+// The oracle's truth for a frame, with the pixels that finite precision cannot decide.
+//
+// A marching kernel does not follow the exact ray: every crossing stops within `eps` of the edge
+// and pushes the point `offset` into the destination room, which shifts the ray sideways by up to
+// `offset`, and float32 rounds every position to about 2^-24 of the scene's scale. After n
+// crossings the kernel's ray may lie up to delta_n = (n + 1) * delta from the exact one, with
+//
+//     delta = eps + offset + 16 * u * scale        (u = 2^-24 for f32, 2^-53 for f64).
+//
+// A pixel whose exact path passes within delta_n of a vertex (a cone point or any corner), runs
+// within delta_n of an edge it does not cross, meets an edge within delta_n of the top or bottom
+// of the wall band (or leaves the band within delta_n of an edge), grazes an object's silhouette
+// (a line shifted delta_n sideways meets the object where the exact one does not, or the other
+// way round), or ends within delta_n of max_distance, can go either way; one that hits a solid
+// near an edge of it, where the normal jumps (a line shifted by the kernel's normal step meets
+// the solid with another normal), has a colour that can go either way: it is reported apart
+// instead of being counted as a failure, in the spirit of VK-GL-CTS's position-deviation compares.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "backends/backend.hpp"
+#include "backends/oracle/oracle.hpp"
+
+namespace flatmarch::conformance {
+
+// Why a ray is ambiguous: a bit each.
+enum Ambiguity : uint8_t {
+  kNearVertex = 1,     // passes within delta_n of a vertex
+  kNearEdge = 2,       // runs within delta_n of an edge it does not cross
+  kBandEdge = 4,       // meets an edge near the band's top or bottom, or leaves the band near one
+  kSilhouette = 8,     // grazes an object: a shifted line decides the object otherwise
+  kNearDistance = 16,  // ends within delta_n of max_distance, on either side
+  kCrease = 32         // hits a solid within the kernel's normal step of an edge of it
+};
+inline constexpr int kAmbiguityReasons = 6;
+
+// delta for these parameters in this scene (above).
+double ambiguity_delta(const Scene& scene, const MarchParams& params);
+
+struct RayTruth {
+  RayEnd end;
+  uint8_t ambiguity = 0;  // Ambiguity bits; 0: the ray is decided
+};
+
+// The oracle's answer for one ray, with its ambiguity at `delta` (max_distance from `params`).
+RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params, double delta);
+
+// The oracle's frame and each pixel's ambiguity.
+struct FrameTruth {
+  Frame frame;
+  std::vector<uint8_t> ambiguity;  // a pixel's Ambiguity bits, row-major as the frame
+  double delta = 0.0;
+  size_t ambiguous() const;
+};
+
+FrameTruth frame_truth(const Scene& scene, const Camera& camera, int width, int height,
+                       const MarchParams& params);
+
+}  // namespace flatmarch::conformance

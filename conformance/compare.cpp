@@ -1,0 +1,250 @@
+#include "conformance/compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+namespace flatmarch::conformance {
+
+namespace {
+
+bool is_object(int hit) {
+  return hit >= 0;
+}
+bool is_escape(int hit) {
+  return hit == kHitEscape || hit == kHitMiss || hit == kHitMaxDistance;
+}
+
+OIIO::ImageBuf colour_image(const Frame& f) {
+  OIIO::ImageBuf image(OIIO::ImageSpec(f.width, f.height, 3, OIIO::TypeDesc::FLOAT));
+  image.set_pixels(OIIO::ROI(0, f.width, 0, f.height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
+                   f.rgb.data());
+  return image;
+}
+
+double quantile(const std::vector<float>& sorted, double q) {
+  if (sorted.empty()) return 0.0;
+  const size_t k = std::min(
+      sorted.size() - 1,
+      static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size()))) - (q > 0.0 ? 1 : 0));
+  return static_cast<double>(sorted[k]);
+}
+
+}  // namespace
+
+const char* to_string(Failure f) {
+  switch (f) {
+    case Failure::stuck:
+      return "stuck";
+    case Failure::wrong_edge:
+      return "wrong_edge";
+    case Failure::missed_object:
+      return "missed_object";
+    case Failure::phantom_hit:
+      return "phantom_hit";
+    case Failure::early_escape:
+      return "early_escape";
+    case Failure::late_escape:
+      return "late_escape";
+    case Failure::leak:
+      return "leak";
+  }
+  return "?";
+}
+
+std::optional<Failure> classify(int hit, int crossings, int want, int want_crossings) {
+  if (hit == want && crossings == want_crossings) return std::nullopt;
+  if (hit == kHitMaxSteps) return Failure::stuck;
+  if (is_object(want) && hit != want) return Failure::missed_object;
+  if (is_object(hit) && hit != want) return Failure::phantom_hit;
+  if (is_escape(hit) && !is_escape(want)) return Failure::early_escape;
+  if (is_escape(want) && !is_escape(hit)) return Failure::late_escape;
+  return Failure::wrong_edge;  // the same end reached by another path, or another wall
+}
+
+ImageComparison compare_images(const Frame& got, const Frame& truth,
+                               const std::vector<uint8_t>& mask, const ImageThresholds& t) {
+  ImageComparison c;
+  c.pixels = truth.rgb.size() / 3;
+  Frame masked = got;  // ambiguous pixels take the truth's colour: they neither pass nor fail
+  for (size_t px = 0; px < mask.size() && px < c.pixels; ++px)
+    if (mask[px]) {
+      ++c.masked;
+      for (size_t k = 0; k < 3; ++k) masked.rgb[3 * px + k] = truth.rgb[3 * px + k];
+    }
+  const OIIO::ImageBuf a = colour_image(masked), b = colour_image(truth);
+  const OIIO::ImageBufAlgo::CompareResults r =
+      OIIO::ImageBufAlgo::compare(a, b, static_cast<float>(t.fail), static_cast<float>(t.warn));
+  c.mean_error = r.meanerror;
+  c.rms_error = r.rms_error;
+  c.psnr = r.PSNR;
+  c.max_error = r.maxerror;
+  c.max_x = r.maxx;
+  c.max_y = r.maxy;
+  c.warn = r.nwarn;
+  c.fail = r.nfail;
+  OIIO::ImageBufAlgo::CompareResults yee;
+  c.perceptual = static_cast<size_t>(std::max(0, OIIO::ImageBufAlgo::compare_Yee(a, b, yee)));
+  const double percent = 100.0 / static_cast<double>(std::max<size_t>(c.pixels, 1));
+  c.failed = static_cast<double>(c.fail) * percent > t.failpercent || c.max_error > t.hardfail;
+  c.warned = static_cast<double>(c.warn) * percent > t.warnpercent;
+  c.perceptual_failed = static_cast<double>(c.perceptual) * percent > t.perceptual_failpercent;
+  return c;
+}
+
+StepStats step_stats(const Channel& steps) {
+  StepStats s;
+  if (steps.empty()) return s;
+  std::vector<float> sorted(steps.begin(), steps.end());
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0.0;
+  for (float v : sorted) sum += static_cast<double>(v);
+  s.mean = sum / static_cast<double>(sorted.size());
+  s.p50 = quantile(sorted, 0.5);
+  s.p90 = quantile(sorted, 0.9);
+  s.p99 = quantile(sorted, 0.99);
+  s.max = static_cast<double>(sorted.back());
+  return s;
+}
+
+double ks_statistic(const Channel& a, const Channel& b) {
+  if (a.empty() || b.empty()) return a.empty() == b.empty() ? 0.0 : 1.0;
+  std::vector<float> x(a.begin(), a.end()), y(b.begin(), b.end());
+  std::sort(x.begin(), x.end());
+  std::sort(y.begin(), y.end());
+  const double nx = static_cast<double>(x.size()), ny = static_cast<double>(y.size());
+  size_t i = 0, k = 0;
+  double gap = 0.0;
+  while (i < x.size() && k < y.size()) {  // at each distinct value, both step functions' heights
+    const float v = std::min(x[i], y[k]);
+    while (i < x.size() && x[i] == v) ++i;
+    while (k < y.size() && y[k] == v) ++k;
+    gap = std::max(gap, std::abs(static_cast<double>(i) / nx - static_cast<double>(k) / ny));
+  }
+  return gap;
+}
+
+double AovComparison::hit_rate() const {
+  return decided() ? static_cast<double>(hit_equal) / static_cast<double>(decided()) : 1.0;
+}
+double AovComparison::crossings_rate() const {
+  return decided() ? static_cast<double>(crossings_equal) / static_cast<double>(decided()) : 1.0;
+}
+
+AovComparison compare_aovs(const Frame& got, const FrameTruth& truth) {
+  AovComparison c;
+  c.pixels = truth.frame.hit.size();
+  for (size_t px = 0; px < c.pixels; ++px) {
+    c.most_steps = std::max(c.most_steps, got.steps[px]);
+    if (const uint8_t bits = truth.ambiguity[px]) {
+      ++c.ambiguous;
+      for (size_t b = 0; b < c.ambiguity_reasons.size(); ++b)
+        c.ambiguity_reasons[b] += (bits >> b) & 1u;
+      continue;
+    }
+    const int hit = static_cast<int>(got.hit[px]), want = static_cast<int>(truth.frame.hit[px]);
+    const int crossings = static_cast<int>(got.crossings[px]);
+    const int want_crossings = static_cast<int>(truth.frame.crossings[px]);
+    c.hit_equal += hit == want;
+    c.crossings_equal += crossings == want_crossings;
+    if (hit != want) ++c.confusion[{want, hit}];
+    if (const auto f = classify(hit, crossings, want, want_crossings))
+      ++c.failures[static_cast<size_t>(*f)];
+  }
+  return c;
+}
+
+std::string describe(const Event& e) {
+  std::string s = std::string(to_string(e.kind)) + " p" + std::to_string(e.polygon);
+  if (e.edge >= 0) s += " e" + std::to_string(e.edge);
+  if (e.object >= 0) s += " o" + std::to_string(e.object);
+  return s;
+}
+
+TraceComparison compare_traces(const Scene& scene, const Trace& got, const Trace& truth,
+                               double eps) {
+  TraceComparison c;
+  const auto& a = got.events;
+  const auto& b = truth.events;
+  c.compared = static_cast<int>(std::min(a.size(), b.size()));
+  for (int i = 0; i < c.compared; ++i) {
+    const Event &e = a[static_cast<size_t>(i)], &w = b[static_cast<size_t>(i)];
+    if (describe(e) != describe(w) || e.to_polygon != w.to_polygon || e.to_edge != w.to_edge) {
+      c.first_divergence = i;
+      c.divergence = "event " + std::to_string(i) + ": got " + describe(e) +
+                     " where the oracle has " + describe(w);
+      break;
+    }
+    c.max_t_error = std::max(c.max_t_error, std::abs(e.t - w.t));
+    if (e.kind == EventKind::gluing || e.kind == EventKind::mirror)
+      c.max_position_error = std::max(c.max_position_error, glm::length(e.at - w.at));
+  }
+  c.length_differs = c.first_divergence < 0 && a.size() != b.size();
+  // A leak: an event in the band that lies outside its room by more than the kernel's own reach.
+  const double reach = 2.0 * eps + 1e-5 * scene.scale;
+  for (size_t i = 0; i < a.size() && !c.leak; ++i) {
+    const Event& e = a[i];
+    if (e.polygon < 0 || e.polygon >= static_cast<int>(scene.polygons.size())) continue;
+    if (!scene.in_band(e.at.z) || e.kind == EventKind::miss) continue;
+    const Polygon& polygon = scene.polygons[static_cast<size_t>(e.polygon)];
+    if (!polygon.contains(Vec2(e.at)) && polygon.distance_to_boundary(Vec2(e.at)) > reach) {
+      c.leak = true;
+      std::ostringstream s;
+      s << "event " << i << " (" << describe(e) << ") lies "
+        << polygon.distance_to_boundary(Vec2(e.at)) << " outside its room";
+      c.leak_at = s.str();
+    }
+  }
+  if (c.leak) {
+    c.failure = Failure::leak;
+  } else if (c.first_divergence >= 0) {
+    const Event& e = a[static_cast<size_t>(c.first_divergence)];
+    const Event& w = b[static_cast<size_t>(c.first_divergence)];
+    const auto end_code = [](const Event& x) {
+      switch (x.kind) {
+        case EventKind::object:
+          return x.object;
+        case EventKind::wall:
+          return kHitWall;
+        case EventKind::floor:
+          return kHitFloor;
+        case EventKind::escape:
+          return kHitEscape;
+        case EventKind::vertex:
+          return kHitVertex;
+        case EventKind::max_steps:
+          return kHitMaxSteps;
+        case EventKind::max_distance:
+          return kHitMaxDistance;
+        case EventKind::miss:
+          return kHitMiss;
+        default:
+          return 1000;  // a crossing: not an end
+      }
+    };
+    const int hit = end_code(e), want = end_code(w);
+    c.failure = (hit == 1000 && want == 1000) ? Failure::wrong_edge
+                                              : classify(hit, 0, want, hit == want ? 0 : 1);
+    if (!c.failure) c.failure = Failure::wrong_edge;
+    // One side crossed where the other ended: classify by what the ending side did.
+    if (hit == 1000 && want != 1000)
+      c.failure = is_object(want)   ? Failure::missed_object
+                  : is_escape(want) ? Failure::late_escape
+                                    : Failure::wrong_edge;
+    if (want == 1000 && hit != 1000)
+      c.failure = hit == kHitMaxSteps ? Failure::stuck
+                  : is_object(hit)    ? Failure::phantom_hit
+                  : is_escape(hit)    ? Failure::early_escape
+                                      : Failure::wrong_edge;
+  } else if (c.length_differs) {
+    c.failure = a.size() < b.size() && !a.empty() && a.back().kind == EventKind::max_steps
+                    ? Failure::stuck
+                    : Failure::wrong_edge;
+  }
+  return c;
+}
+
+}  // namespace flatmarch::conformance

@@ -1,0 +1,271 @@
+#include "conformance/suite.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "backends/scalar/scalar.hpp"
+
+namespace flatmarch::conformance {
+
+namespace {
+
+using nlohmann::json;
+
+// Whether the oracle's path keeps `margin` from every vertex and crosses every edge at a sine of
+// at least `min_sine`.
+bool generic(const Scene& scene, const OracleResult& r, double margin, double min_sine) {
+  const double horizon = r.trace.events.empty() ? 0.0 : r.trace.events.back().t;
+  double t = 0.0;
+  for (const PathSegment& seg : r.path) {
+    if (t > horizon) break;
+    const Vec3 step = seg.to - seg.from;
+    t += glm::length(step);
+    const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
+    for (int v = 0; v < polygon.size(); ++v) {
+      if (distance_to_segment(polygon.vertex(v), Vec2(seg.from), Vec2(seg.to)) < margin)
+        return false;
+      const Edge& edge = polygon.edges[static_cast<size_t>(v)];
+      const bool ends_on_edge =
+          distance_to_segment(Vec2(seg.to), polygon.vertex(v), polygon.vertex(v + 1)) < 1e-9;
+      if (ends_on_edge && glm::length(step) > 0.0 &&
+          std::abs(glm::dot(Vec2(step), edge.normal)) < min_sine * glm::length(step))
+        return false;
+    }
+  }
+  return true;
+}
+
+std::string key(const Scene& scene, const MarchParams& p, int width, int height, bool method) {
+  std::ostringstream s;
+  s.precision(17);
+  s << scene.name << "|" << width << "x" << height << "|" << p.eps << "|" << p.offset << "|"
+    << p.max_distance << "|" << static_cast<int>(p.precision);
+  if (method) s << "|" << static_cast<int>(p.method) << "|" << p.max_steps << "|" << p.omega;
+  return s.str();
+}
+
+void add_check(CaseResult& r, const std::string& name, double value, double limit, bool at_least) {
+  const bool passed = at_least ? value >= limit : value <= limit;
+  r.checks.push_back({name, value, limit, at_least, passed});
+  r.passed &= passed;
+}
+
+}  // namespace
+
+std::vector<std::string> CaseResult::failed_checks() const {
+  std::vector<std::string> lines;
+  for (const Check& c : checks)
+    if (!c.passed) {
+      std::ostringstream s;
+      s << c.name << " " << c.value << (c.at_least ? " < " : " > ") << c.limit;
+      lines.push_back(s.str());
+    }
+  return lines;
+}
+
+std::vector<Ray> probe_rays(const Scene& scene, int count, int events) {
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double top = scene.period ? *scene.period : scene.height;
+  std::vector<Ray> rays;
+  for (int attempt = 0; attempt < 100 * count && static_cast<int>(rays.size()) < count; ++attempt) {
+    const int p = static_cast<int>(unit(rng) * static_cast<double>(scene.polygons.size()));
+    const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
+    Vec2 lo = polygon.vertices[0], hi = lo;
+    for (const Vec2& v : polygon.vertices) lo = glm::min(lo, v), hi = glm::max(hi, v);
+    const Vec2 xy = lo + Vec2(unit(rng), unit(rng)) * (hi - lo);
+    if (!polygon.contains(xy, 0.05 * scene.scale)) continue;
+    const double angle = 2.0 * kPi * unit(rng);
+    const Ray ray{p, Vec3(xy, top * (0.3 + 0.4 * unit(rng))),
+                  Vec3(std::cos(angle), std::sin(angle), 0.05 * (unit(rng) - 0.5))};
+    bool inside_object = false;
+    for (const Object& o : scene.objects)
+      inside_object |= o.polygon == p && glm::length(Vec2(ray.from) - Vec2(o.center)) <
+                                             o.footprint_radius() + 0.05 * scene.scale;
+    if (inside_object) continue;
+    const OracleResult r =
+        oracle_trace(scene, ray, {}, {.max_events = events, .record_path = true});
+    if (generic(scene, r, 0.01 * scene.scale, 0.05)) rays.push_back(ray);
+  }
+  return rays;
+}
+
+Suite::Suite(json thresholds) : thresholds_(std::move(thresholds)) {}
+
+const FrameTruth& Suite::truth(const Scene& scene, const MarchParams& params, int width,
+                               int height) {
+  const std::string k = key(scene, params, width, height, false);
+  auto it = truths_.find(k);
+  if (it == truths_.end())
+    it = truths_.emplace(k, frame_truth(scene, scene.camera, width, height, params)).first;
+  return it->second;
+}
+
+const Frame& Suite::reference(const Scene& scene, const MarchParams& params, int width,
+                              int height) {
+  MarchParams p = params;
+  p.precision = Precision::f64;
+  const std::string k = key(scene, p, width, height, true);
+  auto it = references_.find(k);
+  if (it == references_.end())
+    it = references_.emplace(k, ScalarBackend().render(scene, scene.camera, width, height, p, {}))
+             .first;
+  return it->second;
+}
+
+const std::vector<std::pair<Ray, Trace>>& Suite::probes(const Scene& scene, int count, int events) {
+  const std::string k = scene.name + "|" + std::to_string(count) + "|" + std::to_string(events);
+  auto it = probes_.find(k);
+  if (it == probes_.end()) {
+    std::vector<std::pair<Ray, Trace>> list;
+    for (const Ray& ray : probe_rays(scene, count, events))
+      list.emplace_back(ray, oracle_trace(scene, ray, {}, {.max_events = events}).trace);
+    it = probes_.emplace(k, std::move(list)).first;
+  }
+  return it->second;
+}
+
+CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchParams& params,
+                      int width, int height) {
+  CaseResult r;
+  r.backend = backend.name();
+  r.scene = scene.name;
+  r.params = params;
+  r.width = width;
+  r.height = height;
+  r.thresholds = thresholds_for(thresholds_, r.backend, params.method, scene.name);
+  const Thresholds& t = r.thresholds;
+
+  const FrameTruth& exact = truth(scene, params, width, height);
+  r.delta = exact.delta;
+  const auto started = std::chrono::steady_clock::now();
+  const Frame got = backend.render(scene, scene.camera, width, height, params, {});
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+  r.aov = compare_aovs(got, exact);
+  const double pixels = static_cast<double>(r.aov.pixels);
+  const double decided = static_cast<double>(std::max<size_t>(r.aov.decided(), 1));
+  add_check(r, "hit_rate", r.aov.hit_rate(), t.hit_rate, true);
+  add_check(r, "crossings_rate", r.aov.crossings_rate(), t.crossings_rate, true);
+  add_check(r, "ambiguous", static_cast<double>(r.aov.ambiguous) / pixels, t.ambiguous_max, false);
+  add_check(r, "most_steps", r.aov.most_steps, params.max_steps, false);
+  for (int c = 0; c < kFailureClasses; ++c)
+    add_check(r, std::string("failures.") + to_string(static_cast<Failure>(c)),
+              static_cast<double>(r.aov.failures[static_cast<size_t>(c)]) / decided,
+              t.failure_max[static_cast<size_t>(c)], false);
+
+  r.image = compare_images(got, exact.frame, exact.ambiguity, t.image);
+  add_check(r, "image.failpercent", 100.0 * static_cast<double>(r.image.fail) / pixels,
+            t.image.failpercent, false);
+  add_check(r, "image.max_error", r.image.max_error, t.image.hardfail, false);
+  add_check(r, "image.perceptual_failpercent",
+            100.0 * static_cast<double>(r.image.perceptual) / pixels,
+            t.image.perceptual_failpercent, false);
+  if (r.image.warned)
+    r.warnings.push_back(std::to_string(r.image.warn) + " pixels differ by more than " +
+                         std::to_string(t.image.warn));
+
+  const Frame& ref = reference(scene, params, width, height);
+  r.steps = step_stats(got.steps);
+  r.reference_steps = step_stats(ref.steps);
+  r.steps_ks = ks_statistic(got.steps, ref.steps);
+  add_check(r, "steps.ks", r.steps_ks, t.steps_ks_max, false);
+  const double ratio = r.reference_steps.mean > 0.0 ? r.steps.mean / r.reference_steps.mean : 1.0;
+  add_check(r, "steps.mean_ratio", std::max(ratio, 1.0 / std::max(ratio, 1e-9)),
+            t.steps_mean_ratio_max, false);
+
+  int diverged = 0;
+  double trace_error = 0.0;
+  for (const auto& [ray, want] : probes(scene, t.probe_rays, t.trace_events)) {
+    const Trace trace = backend.trace(scene, ray, params, t.trace_events);
+    TraceComparison c = compare_traces(scene, trace, want, params.eps);
+    if (c.failure) {
+      ++diverged;
+      ++r.trace_failures[static_cast<size_t>(*c.failure)];
+    }
+    trace_error = std::max({trace_error, c.max_t_error, c.max_position_error});
+    r.traces.push_back(std::move(c));
+  }
+  add_check(r, "traces.diverged", diverged, t.trace_failures_max, false);
+  add_check(r, "traces.error", trace_error / scene.scale, t.trace_error, false);
+  if (static_cast<int>(r.traces.size()) < t.probe_rays)
+    r.warnings.push_back("only " + std::to_string(r.traces.size()) + " generic probe rays found");
+  return r;
+}
+
+json to_json(const CaseResult& r) {
+  json failures = json::object(), trace_failures = json::object();
+  for (int c = 0; c < kFailureClasses; ++c) {
+    failures[to_string(static_cast<Failure>(c))] = r.aov.failures[static_cast<size_t>(c)];
+    trace_failures[to_string(static_cast<Failure>(c))] = r.trace_failures[static_cast<size_t>(c)];
+  }
+  const char* reasons[] = {"near_vertex", "near_edge",     "band_edge",
+                           "silhouette",  "near_distance", "crease"};
+  json ambiguity = json::object();
+  for (size_t b = 0; b < r.aov.ambiguity_reasons.size(); ++b)
+    ambiguity[reasons[b]] = r.aov.ambiguity_reasons[b];
+  json confusion = json::array();
+  for (const auto& [hits, count] : r.aov.confusion)
+    confusion.push_back({{"oracle", hits.first}, {"got", hits.second}, {"pixels", count}});
+  json traces = json::array();
+  for (const TraceComparison& c : r.traces) {
+    json tr = {{"compared", c.compared},
+               {"first_divergence", c.first_divergence},
+               {"max_t_error", c.max_t_error},
+               {"max_position_error", c.max_position_error}};
+    if (!c.divergence.empty()) tr["divergence"] = c.divergence;
+    if (c.leak) tr["leak"] = c.leak_at;
+    if (c.failure) tr["failure"] = to_string(*c.failure);
+    traces.push_back(tr);
+  }
+  json checks = json::array();
+  for (const Check& c : r.checks)
+    checks.push_back({{"name", c.name},
+                      {"value", c.value},
+                      {"limit", c.limit},
+                      {"at_least", c.at_least},
+                      {"passed", c.passed}});
+  const auto stats = [](const StepStats& s) {
+    return json{{"mean", s.mean}, {"p50", s.p50}, {"p90", s.p90}, {"p99", s.p99}, {"max", s.max}};
+  };
+  return {{"backend", r.backend},
+          {"scene", r.scene},
+          {"method", to_string(r.params.method)},
+          {"precision", r.params.precision == Precision::f32 ? "f32" : "f64"},
+          {"eps", r.params.eps},
+          {"offset", r.params.offset},
+          {"max_steps", r.params.max_steps},
+          {"max_distance", r.params.max_distance},
+          {"size", std::to_string(r.width) + "x" + std::to_string(r.height)},
+          {"passed", r.passed},
+          {"seconds", r.seconds},
+          {"delta", r.delta},
+          {"pixels", r.aov.pixels},
+          {"ambiguous", r.aov.ambiguous},
+          {"ambiguity", ambiguity},
+          {"hit_rate", r.aov.hit_rate()},
+          {"crossings_rate", r.aov.crossings_rate()},
+          {"failures", failures},
+          {"confusion", confusion},
+          {"image",
+           {{"mean_error", r.image.mean_error},
+            {"rms_error", r.image.rms_error},
+            {"psnr", r.image.psnr},
+            {"max_error", r.image.max_error},
+            {"max_at", {r.image.max_x, r.image.max_y}},
+            {"warn", r.image.warn},
+            {"fail", r.image.fail},
+            {"perceptual", r.image.perceptual}}},
+          {"steps", stats(r.steps)},
+          {"reference_steps", stats(r.reference_steps)},
+          {"steps_ks", r.steps_ks},
+          {"traces", traces},
+          {"trace_failures", trace_failures},
+          {"checks", checks},
+          {"warnings", r.warnings},
+          {"thresholds", to_json(r.thresholds)}};
+}
+
+}  // namespace flatmarch::conformance

@@ -1,0 +1,77 @@
+// One conformance case: a backend, a scene, a method and its parameters, measured against the
+// oracle — frame (hit, crossings, colour, steps) and probe-ray traces — and judged by the
+// thresholds. The suite caches the truth (oracle frames, probe rays and their traces, the steps
+// reference) across the cases that share it.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "conformance/ambiguity.hpp"
+#include "conformance/compare.hpp"
+#include "conformance/thresholds.hpp"
+
+namespace flatmarch::conformance {
+
+// One threshold checked: `value` against `limit` (`at_least`: value >= limit, else <=).
+struct Check {
+  std::string name;
+  double value = 0.0, limit = 0.0;
+  bool at_least = false;
+  bool passed = true;
+};
+
+struct CaseResult {
+  std::string backend, scene;
+  MarchParams params;
+  int width = 0, height = 0;
+  Thresholds thresholds;
+  double delta = 0.0;  // the ambiguity mask's delta (ambiguity.hpp)
+  AovComparison aov;
+  ImageComparison image;
+  StepStats steps, reference_steps;  // reference: the scalar backend in float64
+  double steps_ks = 0.0;
+  std::vector<TraceComparison> traces;
+  FailureCounts trace_failures{};
+  std::vector<Check> checks;
+  std::vector<std::string> warnings;
+  bool passed = true;
+  double seconds = 0.0;  // the backend's frame
+  // The checks that failed, one line each.
+  std::vector<std::string> failed_checks() const;
+};
+
+// Nearly horizontal rays from random points of random rooms (a fixed seed), kept when their exact
+// path up to `events` events keeps 1% of the scene's scale from every vertex and crosses every
+// edge at a sine of at least 0.05: rays whose fate neither rounding nor eps can decide.
+std::vector<Ray> probe_rays(const Scene& scene, int count, int events);
+
+class Suite {
+ public:
+  explicit Suite(nlohmann::json thresholds = builtin_thresholds());
+  // Runs one case at `width` x `height` with the scene's camera. Exceptions from the backend
+  // (a failed compile, a validation message) propagate.
+  CaseResult run(const Backend& backend, const Scene& scene, const MarchParams& params, int width,
+                 int height);
+  const nlohmann::json& thresholds() const { return thresholds_; }
+
+ private:
+  const FrameTruth& truth(const Scene& scene, const MarchParams& params, int width, int height);
+  const Frame& reference(const Scene& scene, const MarchParams& params, int width, int height);
+  const std::vector<std::pair<Ray, Trace>>& probes(const Scene& scene, int count, int events);
+
+  nlohmann::json thresholds_;
+  std::map<std::string, FrameTruth> truths_;
+  std::map<std::string, Frame> references_;
+  std::map<std::string, std::vector<std::pair<Ray, Trace>>> probes_;
+};
+
+nlohmann::json to_json(const CaseResult& r);
+
+}  // namespace flatmarch::conformance

@@ -1,0 +1,316 @@
+// The conformance library against hand-worked values: distributions, failure classes, traces,
+// images, the ambiguity mask on hand-built rooms, thresholds' layering, and whole cases with a
+// backend broken on purpose.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "backends/scalar/scalar.hpp"
+#include "conformance/suite.hpp"
+#include "scene/load.hpp"
+#include "tests/process.hpp"
+#include "tests/test_scenes.hpp"
+
+namespace flatmarch::conformance {
+namespace {
+
+Channel channel(std::initializer_list<float> v) {
+  return Channel(v.begin(), v.end());
+}
+
+TEST(Steps, KolmogorovSmirnovIsTheLargestGapOfTheCumulativeShares) {
+  // CDFs of {1,2,3,4} and {3,4,5,6}: at 2 they are 1/2 and 0, at 4 1 and 1/2.
+  EXPECT_DOUBLE_EQ(ks_statistic(channel({1, 2, 3, 4}), channel({3, 4, 5, 6})), 0.5);
+  EXPECT_DOUBLE_EQ(ks_statistic(channel({1, 2, 3}), channel({3, 2, 1})), 0.0);
+  EXPECT_DOUBLE_EQ(ks_statistic(channel({1, 1}), channel({2, 2, 2})), 1.0);
+}
+
+TEST(Steps, StatsOfOneToAHundred) {
+  Channel steps;
+  for (int k = 1; k <= 100; ++k) steps.push_back(static_cast<float>(k));
+  const StepStats s = step_stats(steps);
+  EXPECT_DOUBLE_EQ(s.mean, 50.5);
+  EXPECT_DOUBLE_EQ(s.p50, 50.0);
+  EXPECT_DOUBLE_EQ(s.p90, 90.0);
+  EXPECT_DOUBLE_EQ(s.p99, 99.0);
+  EXPECT_DOUBLE_EQ(s.max, 100.0);
+}
+
+TEST(Failures, EachClassFromTheRaysEnds) {
+  EXPECT_FALSE(classify(kHitWall, 3, kHitWall, 3));
+  EXPECT_EQ(classify(kHitMaxSteps, 9, kHitWall, 3), Failure::stuck);
+  EXPECT_EQ(classify(kHitWall, 3, 0, 3), Failure::missed_object);
+  EXPECT_EQ(classify(1, 3, 0, 3), Failure::missed_object);
+  EXPECT_EQ(classify(0, 3, kHitWall, 3), Failure::phantom_hit);
+  EXPECT_EQ(classify(kHitEscape, 3, kHitFloor, 3), Failure::early_escape);
+  EXPECT_EQ(classify(kHitMaxDistance, 3, kHitWall, 3), Failure::early_escape);
+  EXPECT_EQ(classify(kHitWall, 3, kHitEscape, 3), Failure::late_escape);
+  EXPECT_EQ(classify(kHitWall, 4, kHitWall, 3), Failure::wrong_edge);
+  EXPECT_EQ(classify(kHitEscape, 2, kHitEscape, 3), Failure::wrong_edge);
+}
+
+Scene torus(const std::string& extra = "") {
+  return parse_scene(test::torus_json(extra), "torus.json");
+}
+
+Event gluing(int edge, Vec3 at, double t) {
+  Event e;
+  e.kind = EventKind::gluing;
+  e.polygon = 0;
+  e.edge = edge;
+  e.to_polygon = 0;
+  e.to_edge = (edge + 2) % 4;
+  e.t = t;
+  e.at = at;
+  return e;
+}
+
+TEST(Traces, PositionErrorDivergenceAndLeak) {
+  const Scene scene = torus();
+  Trace truth;
+  truth.events = {gluing(1, {4, 2, 1}, 3.0), gluing(1, {4, 2, 1}, 7.0)};
+  Trace got = truth;
+  got.events[1].at.y += 0.001;
+  got.events[1].t += 0.002;
+  TraceComparison c = compare_traces(scene, got, truth, 1e-4);
+  EXPECT_EQ(c.first_divergence, -1);
+  EXPECT_NEAR(c.max_position_error, 0.001, 1e-12);
+  EXPECT_NEAR(c.max_t_error, 0.002, 1e-12);
+  EXPECT_FALSE(c.failure);
+
+  got.events[1] = gluing(2, {3.9, 4, 1}, 6.9);  // through the top instead
+  c = compare_traces(scene, got, truth, 1e-4);
+  EXPECT_EQ(c.first_divergence, 1);
+  EXPECT_EQ(c.failure, Failure::wrong_edge);
+
+  got.events[1] = gluing(1, {4.5, 2, 1}, 7.0);  // half a unit outside the room
+  c = compare_traces(scene, got, truth, 1e-4);
+  EXPECT_TRUE(c.leak);
+  EXPECT_EQ(c.failure, Failure::leak);
+
+  got.events.resize(1);  // ran out of steps after the first crossing
+  Event stuck;
+  stuck.kind = EventKind::max_steps;
+  stuck.at = {1, 2, 1};
+  got.events.push_back(stuck);
+  c = compare_traces(scene, got, truth, 1e-4);
+  EXPECT_EQ(c.failure, Failure::stuck);
+}
+
+TEST(Images, FailAndWarnLikeIdiffAndTheMaskLeavesPixelsOut) {
+  Frame a(4, 4), b(4, 4);
+  for (size_t k = 0; k < a.rgb.size(); ++k) a.rgb[k] = b.rgb[k] = 0.5f;
+  a.rgb[3 * 5] = 0.6f;   // pixel 5 differs by 0.1 in red: fails at 0.05
+  a.rgb[3 * 6] = 0.52f;  // pixel 6 by 0.02: warns at 0.01
+  std::vector<uint8_t> mask(16, 0);
+  ImageThresholds t;  // fail 0.05 over 1%, warn 0.01 over 5%
+  ImageComparison c = compare_images(a, b, mask, t);
+  EXPECT_EQ(c.fail, 1u);
+  EXPECT_EQ(c.warn, 2u);  // idiff counts failures among the warnings
+  EXPECT_NEAR(c.max_error, 0.1, 1e-6);
+  EXPECT_EQ(c.max_x, 1);
+  EXPECT_EQ(c.max_y, 1);
+  EXPECT_TRUE(c.failed);  // 1 of 16 pixels: 6.25% > 1%
+  mask[5] = kSilhouette;
+  c = compare_images(a, b, mask, t);
+  EXPECT_EQ(c.fail, 0u);
+  EXPECT_EQ(c.masked, 1u);
+  EXPECT_FALSE(c.failed);
+  EXPECT_TRUE(c.warned);  // 1 of 16 over 0.01: 6.25% > 5%
+}
+
+uint8_t ambiguity_of(const Scene& scene, Vec3 from, Vec3 dir, double max_distance = 100.0) {
+  MarchParams params;  // eps 1e-4, offset 2e-4, f32: delta = 3e-4 + 16 * 2^-24 * 4 ~ 3.04e-4
+  params.max_distance = max_distance;
+  return ray_truth(scene, {0, from, dir}, params, ambiguity_delta(scene, params)).ambiguity;
+}
+
+TEST(Ambiguity, DeltaIsEpsPlusOffsetPlusRounding) {
+  const Scene scene = torus();  // scale 4
+  MarchParams params;
+  EXPECT_NEAR(ambiguity_delta(scene, params), 3e-4 + 16.0 * 4.0 / 16777216.0, 1e-15);
+  params.precision = Precision::f64;
+  EXPECT_NEAR(ambiguity_delta(scene, params), 3e-4 + 16.0 * 4.0 * 0x1p-53, 1e-18);
+}
+
+TEST(Ambiguity, VerticesEdgesAndTheBand) {
+  const Scene scene = torus();
+  // Along y = 2 the ray crosses the glued sides at their middles forever: decided.
+  EXPECT_EQ(ambiguity_of(scene, {1, 2, 1}, {1, 0, 0}), 0);
+  // Straight into the corner (4, 4): the oracle ends with `vertex`.
+  EXPECT_NE(ambiguity_of(scene, {1, 1, 1}, {1, 1, 0}) & kNearVertex, 0);
+  // 1e-4 above the bottom edge, along it: within delta of the edge and of the corner (4, 0).
+  const uint8_t along = ambiguity_of(scene, {1, 1e-4, 1}, {1, 0, 0});
+  EXPECT_NE(along & kNearEdge, 0);
+  EXPECT_NE(along & kNearVertex, 0);
+  // From (1, 2, 1) along (3, 0, 1) the ray meets the edge x = 4 exactly at the band's top, z = 2;
+  // along (3, 0, 0.9) at z = 1.9, well below.
+  EXPECT_NE(ambiguity_of(scene, {1, 2, 1}, {3, 0, 1}) & kBandEdge, 0);
+  EXPECT_EQ(ambiguity_of(scene, {1, 2, 1}, {3, 0, 0.9}), 0);
+}
+
+TEST(Ambiguity, SilhouettesCreasesAndTheDistanceLimit) {
+  const Scene sphere = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
+                                             "radius": 0.5}])");
+  EXPECT_NE(ambiguity_of(sphere, {0.5, 2.5, 1}, {1, 0, 0}) & kSilhouette, 0);  // tangent
+  EXPECT_EQ(ambiguity_of(sphere, {0.5, 2.4, 1}, {1, 0, 0}), 0);  // a clear hit: smooth, no crease
+  EXPECT_EQ(ambiguity_of(sphere, {0.5, 2.9, 1}, {1, 0, 0}), 0);  // a clear miss... of this copy
+  const Scene box = torus(R"("objects": [{"type": "box", "polygon": 0, "center": [2, 2, 1],
+                                          "half": [0.5, 0.5, 0.5]}])");
+  EXPECT_EQ(ambiguity_of(box, {0.5, 2, 1}, {1, 0, 0}), 0);  // the middle of the face x = 1.5
+  // 1e-3 from the face's edge y = 2.5: a hit, but within the kernel's normal step (1.5 * 2^-8 *
+  // 4 ~ 0.023) of the edge, where the normal turns from -x to +y.
+  const uint8_t edge = ambiguity_of(box, {0.5, 2.499, 1}, {1, 0, 0});
+  EXPECT_EQ(edge & kSilhouette, 0);
+  EXPECT_NE(edge & kCrease, 0);
+  // The box's face is 1.0 away: a limit of 1.0001 ends a hair beyond it, 2.0 well beyond.
+  EXPECT_NE(ambiguity_of(box, {0.5, 2, 1}, {1, 0, 0}, 1.0001) & kNearDistance, 0);
+  EXPECT_EQ(ambiguity_of(box, {0.5, 2, 1}, {1, 0, 0}, 2.0), 0);
+}
+
+TEST(Thresholds, LayersApplyInOrderAndExceptionsSayWhy) {
+  const nlohmann::json doc = nlohmann::json::parse(R"({
+    "defaults": {"hit_rate": 0.9, "crossings_rate": 0.8},
+    "methods": {"sphere": {"hit_rate": 0.8}},
+    "backends": {"simd": {"hit_rate": 0.7}},
+    "exceptions": [{"scenes": ["torus"], "methods": ["sphere"], "why": "slow corners",
+                    "set": {"failures": {"stuck": 0.5}}}]})");
+  Thresholds t = thresholds_for(doc, "scalar", Method::analytic, "cube");
+  EXPECT_EQ(t.hit_rate, 0.9);
+  EXPECT_EQ(t.crossings_rate, 0.8);
+  EXPECT_EQ(thresholds_for(doc, "scalar", Method::sphere, "cube").hit_rate, 0.8);
+  t = thresholds_for(doc, "simd", Method::sphere, "torus");
+  EXPECT_EQ(t.hit_rate, 0.7);
+  EXPECT_EQ(t.failure_max[static_cast<size_t>(Failure::stuck)], 0.5);
+  EXPECT_EQ(t.why, "slow corners");
+  EXPECT_EQ(thresholds_for(doc, "simd", Method::relaxed, "torus").why, "");
+}
+
+TEST(Thresholds, ABadFileNamesTheKey) {
+  const auto path = std::filesystem::temp_directory_path() / "flatmarch_thresholds_test.json";
+  const auto error = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    try {
+      load_thresholds(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error(R"({"defaults": {"hit_rat": 0.9}})").find("/defaults/hit_rat: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"defaults": {"hit_rate": 2}})").find("/defaults/hit_rate: must lie in"),
+            std::string::npos);
+  EXPECT_NE(error(R"({"exceptions": [{"set": {}}]})").find("must say why"), std::string::npos);
+  EXPECT_NE(error(R"({"defaults": {"failures": {"stuk": 0}}})").find("unknown failure class"),
+            std::string::npos);
+  EXPECT_NE(error("{").find("parse error"), std::string::npos);
+  std::filesystem::remove(path);
+  // The built-in file passes its own checks.
+  EXPECT_NO_THROW(builtin_thresholds());
+}
+
+// The scalar backend with one thing broken on purpose.
+class Broken : public Backend {
+ public:
+  enum class Flaw { extra_crossing, phantom_object, leaking_trace };
+  explicit Broken(Flaw flaw) : flaw_(flaw) {}
+  std::string name() const override { return "scalar"; }
+  std::string description() const override { return "scalar, broken on purpose"; }
+  Availability availability() const override { return {}; }
+  std::vector<Method> methods() const override { return scalar_.methods(); }
+  Frame render(const Scene& scene, const Camera& camera, int width, int height,
+               const MarchParams& params, const Progress& progress) const override {
+    Frame f = scalar_.render(scene, camera, width, height, params, progress);
+    for (size_t px = 0; px < f.hit.size(); px += 7) {
+      if (flaw_ == Flaw::extra_crossing) f.crossings[px] += 1.0f;
+      if (flaw_ == Flaw::phantom_object && f.hit[px] < 0.0f) f.hit[px] = 0.0f;
+    }
+    return f;
+  }
+  Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
+              int max_events) const override {
+    Trace t = scalar_.trace(scene, ray, params, max_events);
+    if (flaw_ == Flaw::leaking_trace && t.events.size() > 1) t.events[1].at.x += 0.5 * scene.scale;
+    return t;
+  }
+
+ private:
+  Flaw flaw_;
+  ScalarBackend scalar_;
+};
+
+bool failed(const CaseResult& r, const std::string& check) {
+  for (const Check& c : r.checks)
+    if (c.name == check && !c.passed) return true;
+  return false;
+}
+
+TEST(Suite, TheScalarBackendPassesAndEachFlawIsCaughtByItsCheck) {
+  const Scene scene = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
+                                            "radius": 0.5}], "camera": {"position": [0.5, 0.7, 1],
+                                            "yaw_deg": 20})");
+  MarchParams params;
+  params.method = Method::analytic;
+  Suite suite;
+  const CaseResult good = suite.run(ScalarBackend(), scene, params, 64, 36);
+  EXPECT_TRUE(good.passed) << testing::PrintToString(good.failed_checks());
+  EXPECT_EQ(good.traces.size(), 8u);
+
+  const CaseResult crossing =
+      suite.run(Broken(Broken::Flaw::extra_crossing), scene, params, 64, 36);
+  EXPECT_FALSE(crossing.passed);
+  EXPECT_TRUE(failed(crossing, "crossings_rate"));
+  EXPECT_TRUE(failed(crossing, "failures.wrong_edge"));
+
+  const CaseResult phantom = suite.run(Broken(Broken::Flaw::phantom_object), scene, params, 64, 36);
+  EXPECT_TRUE(failed(phantom, "hit_rate"));
+  EXPECT_TRUE(failed(phantom, "failures.phantom_hit"));
+
+  const CaseResult leak = suite.run(Broken(Broken::Flaw::leaking_trace), scene, params, 64, 36);
+  EXPECT_TRUE(failed(leak, "traces.diverged"));
+  EXPECT_GT(leak.trace_failures[static_cast<size_t>(Failure::leak)], 0u);
+}
+
+TEST(CliConform, PrintsATableWritesJsonAndExitsByTheVerdict) {
+  const std::string dir = test::make_temp_dir();
+  const std::string json = dir + "/conform.json";
+  const std::string torus = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
+  test::ProcessResult r = test::run_flatmarch(
+      {"conform", "--backend", "scalar", "--scene", torus, "--method", "analytic", "--json", json});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("scalar   torus"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 cases, 1 passed, 0 failed"), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  ASSERT_EQ(doc["cases"].size(), 1u);
+  EXPECT_EQ(doc["cases"][0]["scene"], "torus");
+  EXPECT_EQ(doc["cases"][0]["hit_rate"], 1.0);
+
+  // Thresholds no backend can meet: the case fails, the check is named, the exit code is 1.
+  const std::string strict = dir + "/strict.json";
+  std::ofstream(strict) << R"({"defaults": {"ambiguous_max": 0}})";
+  r = test::run_flatmarch({"conform", "--backend", "scalar", "--scene", "torus", "--gallery",
+                           std::string(FLATMARCH_SOURCE_DIR) + "/scenes", "--method", "analytic",
+                           "--thresholds", strict, "--json", json});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.out.find("ambiguous"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("1 of 1 cases failed"), std::string::npos) << r.err;
+
+  r = test::run_flatmarch({"conform", "--backend", "nonesuch", "--scene", torus});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown backend"), std::string::npos) << r.err;
+  std::ofstream(strict) << R"({"defaults": {"hit_rat": 1}})";
+  r = test::run_flatmarch({"conform", "--scene", torus, "--thresholds", strict});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("/defaults/hit_rat: unknown key"), std::string::npos) << r.err;
+  r = test::run_flatmarch({"conform", "--scene", "no_such_scene"});
+  EXPECT_EQ(r.exit_code, 2);
+  r = test::run_flatmarch({"conform", "--scene", torus, "--method", "oracle"});
+  EXPECT_EQ(r.exit_code, 2);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace flatmarch::conformance

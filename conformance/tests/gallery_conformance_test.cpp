@@ -1,0 +1,71 @@
+// The conformance suite on the gallery: every kernel backend (scalar, simd, opengl through
+// OSMesa, vulkan on lavapipe under the validation layer) x every gallery scene x every method,
+// at default parameters, measured against the oracle and judged by conformance/thresholds.json.
+// Labelled `conformance`. A backend that is unavailable here is skipped, with the reason.
+#include <gtest/gtest.h>
+
+#include <iostream>
+
+#include "conformance/suite.hpp"
+#include "tests/gallery.hpp"
+#include "tests/opengl_backend.hpp"
+#include "tests/vulkan_backend.hpp"
+
+namespace flatmarch::conformance {
+namespace {
+
+struct Case {
+  std::string backend, scene;
+  Method method;
+};
+
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.backend << " " << c.scene << " " << to_string(c.method);
+}
+
+const Backend& backend_named(const std::string& name) {
+  if (name == "opengl") return test::opengl();
+  if (name == "vulkan") return test::vulkan();
+  static std::map<std::string, std::unique_ptr<Backend>> made;
+  auto& b = made[name];
+  if (!b) b = make_backend(name, {});
+  return *b;
+}
+
+class GalleryConformance : public testing::TestWithParam<Case> {};
+
+TEST_P(GalleryConformance, MeetsItsThresholds) {
+  const Backend& backend = backend_named(GetParam().backend);
+  if (const Availability a = backend.availability(); !a.available)
+    GTEST_SKIP() << "the " << GetParam().backend << " backend is unavailable here: " << a.reason;
+  const Scene& scene = test::gallery_scene(GetParam().scene);
+  MarchParams params;
+  params.method = GetParam().method;
+  Suite suite;
+  const CaseResult r = suite.run(backend, scene, params, 160, 90);
+  std::cout << "[ figures  ] " << to_json(r).dump() << "\n";
+  for (const std::string& line : r.failed_checks()) ADD_FAILURE() << line;
+  for (const TraceComparison& t : r.traces) {
+    if (!t.divergence.empty()) std::cout << "  trace: " << t.divergence << "\n";
+    if (t.leak) std::cout << "  trace: leak: " << t.leak_at << "\n";
+  }
+  if (!r.thresholds.why.empty()) std::cout << "  exceptions: " << r.thresholds.why << "\n";
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> all;
+  for (const std::string backend : {"scalar", "simd", "opengl", "vulkan"})
+    for (const std::string& name : test::gallery_names())
+      for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
+        all.push_back({backend, name, m});
+  return all;
+}
+
+INSTANTIATE_TEST_SUITE_P(Gallery, GalleryConformance, testing::ValuesIn(cases()),
+                         [](const testing::TestParamInfo<Case>& param) {
+                           return param.param.backend + "_" + param.param.scene + "_" +
+                                  to_string(param.param.method);
+                         });
+
+}  // namespace
+}  // namespace flatmarch::conformance
