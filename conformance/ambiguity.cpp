@@ -57,7 +57,7 @@ std::vector<int> solids_in(const Scene& scene, int p) {
 // far); `last` and `end` say whether and how the path ends with it, `crease` is the width over
 // which the kernel's normal (a finite difference) blurs an edge of a solid.
 uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last, const RayEnd& end,
-                          double delta, double crease) {
+                          double delta, double eps, double crease) {
   const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
   const Vec2 from(seg.from), to(seg.to);
   const double on = 1e-9 * scene.scale;  // a point this close to an edge lies on it
@@ -95,9 +95,11 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
     const bool exact = last && end.hit == index;
     // A shifted line meets a solid where the surface has moved away: further on where the ray
     // hits it, within the room (and delta) where it does not.
-    const double limit = length + delta + (exact ? scene.scale : 0.0);
+    // Every method stops within eps of a solid: a line passing that close counts as a hit.
+    const double shifted = delta + eps;
+    const double limit = length + shifted + (exact ? scene.scale : 0.0);
     for (const Vec3 shift : {e1, -e1, e2, -e2})
-      if (meet(scene, seg.polygon, index, seg.from + delta * shift, d, limit).has_value() !=
+      if (meet(scene, seg.polygon, index, seg.from + shifted * shift, d, limit).has_value() !=
           exact) {
         bits |= kSilhouette;
         break;
@@ -107,7 +109,7 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
     if (!exact || (bits & kSilhouette)) continue;
     // On a smooth surface the normals a shift to either side finds differ from this one by as
     // much; across an edge one side jumps.
-    const double reach = std::max(delta, crease);
+    const double reach = std::max(shifted, crease);
     for (const Vec3 axis : {e1, e2}) {
       const auto plus = meet(scene, seg.polygon, index, seg.from + reach * axis, d, limit);
       const auto minus = meet(scene, seg.polygon, index, seg.from - reach * axis, d, limit);
@@ -125,7 +127,9 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
 }  // namespace
 
 double ambiguity_delta(const Scene& scene, const MarchParams& params) {
-  return params.eps + params.offset + 16.0 * unit_roundoff(params.precision) * scene.scale;
+  const double rounding = 16.0 * unit_roundoff(params.precision) * scene.scale;
+  if (params.method == Method::analytic) return 2.0 * rounding;  // and the vertex tolerance
+  return params.eps + params.offset + rounding;
 }
 
 RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params, double delta) {
@@ -141,12 +145,17 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
   // At a crossing the kernel places its point `offset` inside the new room, from wherever within
   // eps of the edge it stopped: the ray moves (eps + offset) sin(angle) sideways, the angle
   // between the ray and the edge's normal. The drifts add up, as they may in the worst case.
+  // The analytic method crosses at the exit point it computed, with no push: only rounding.
+  const double u = unit_roundoff(params.precision);
+  const double push = params.method == Method::analytic ? 0.0 : params.eps + params.offset;
   double drift = delta;
   int crossings = 0;
   for (size_t k = 0; k < r.path.size(); ++k) {
     const PathSegment& seg = r.path[k];
     const bool last = k + 1 == r.path.size();
-    truth.ambiguity |= segment_ambiguity(scene, seg, last, r.end, drift, crease);
+    truth.ambiguity |= segment_ambiguity(scene, seg, last, r.end, drift, params.eps, crease);
+    // The direction is rounded too: the ray turns by about 2^-24, so drifts that much a unit.
+    drift += 4.0 * u * glm::length(seg.to - seg.from);
     if (last || !scene.in_band(seg.from.z)) continue;
     const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
     for (int e = 0; e < polygon.size(); ++e)
@@ -155,8 +164,7 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
         const double length = glm::length(step);
         const Vec3 n(polygon.edges[static_cast<size_t>(e)].normal, 0.0);
         const double along = length > 0.0 ? glm::dot(n, step) / length : 0.0;
-        drift += (params.eps + params.offset) * std::sqrt(std::max(0.0, 1.0 - along * along)) +
-                 16.0 * unit_roundoff(params.precision) * scene.scale;
+        drift += push * std::sqrt(std::max(0.0, 1.0 - along * along)) + 16.0 * u * scene.scale;
         ++crossings;
         break;
       }

@@ -1,20 +1,30 @@
 // The oracle's truth for a frame, with the pixels that finite precision cannot decide.
 //
-// A marching kernel does not follow the exact ray: every crossing stops within `eps` of the edge
-// and pushes the point `offset` into the destination room, which shifts the ray sideways by up to
-// `offset`, and float32 rounds every position to about 2^-24 of the scene's scale. After n
-// crossings the kernel's ray may lie up to delta_n = (n + 1) * delta from the exact one, with
+// A marching kernel does not follow the exact ray. Sphere tracing (and its relaxed form) stops
+// within `eps` of an edge and places the point `offset` inside the destination room, which moves
+// the ray (eps + offset) sin(a) sideways, a the angle between the ray and the edge's normal; the
+// analytic method crosses at the exit point it computed, with no push. Both round every position
+// to about u = 2^-24 (f32) or 2^-53 (f64) of the scene's scale, and their direction turns by about
+// u, so the ray drifts a few u a unit of length. So the kernel's ray may lie up to
 //
-//     delta = eps + offset + 16 * u * scale        (u = 2^-24 for f32, 2^-53 for f64).
+//     delta_n = delta + sum over the crossings so far of (push sin(a) + 16 u scale)
+//               + 4 u (length so far)
+//     delta   = eps + offset + 16 u scale      (sphere, relaxed; push = eps + offset)
+//             = 32 u scale                     (analytic: rounding and its vertex tolerance;
+//                                               push = 0)
+//
+// from the exact one: the drifts add up, as they may in the worst case.
 //
 // A pixel whose exact path passes within delta_n of a vertex (a cone point or any corner), runs
 // within delta_n of an edge it does not cross, meets an edge within delta_n of the top or bottom
 // of the wall band (or leaves the band within delta_n of an edge), grazes an object's silhouette
-// (a line shifted delta_n sideways meets the object where the exact one does not, or the other
-// way round), or ends within delta_n of max_distance, can go either way; one that hits a solid
-// near an edge of it, where the normal jumps (a line shifted by the kernel's normal step meets
-// the solid with another normal), has a colour that can go either way: it is reported apart
-// instead of being counted as a failure, in the spirit of VK-GL-CTS's position-deviation compares.
+// (a line shifted delta_n + eps sideways, eps because every method stops that near a solid, meets
+// the object where the exact one does not, or the other way round), or ends near max_distance
+// (within delta_n plus the push's shortening of the path and t's rounding, on either side) can go
+// either way; one that hits a solid near an edge of it, where the normal jumps (a line shifted by
+// the kernel's normal step meets the solid with a normal that differs on one side only), has a
+// colour that can go either way. Such pixels are reported apart instead of being counted as
+// failures, in the spirit of VK-GL-CTS's position-deviation compares.
 #pragma once
 
 #include <cstdint>
