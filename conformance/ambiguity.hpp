@@ -20,7 +20,8 @@
 // of the wall band (or leaves the band within delta_n of an edge), grazes an object's silhouette
 // (a line shifted delta_n + eps sideways, eps because every method stops that near a solid, meets
 // the object where the exact one does not, or the other way round), or ends near max_distance
-// (within delta_n plus the push's shortening of the path and t's rounding, on either side) can go
+// (within delta_n plus the push's shortening of the path, t's rounding and 10 eps, as solids are
+// hit within eps of them, on either side) can go
 // either way; one that hits a solid near an edge of it, where the normal jumps (a line shifted by
 // the kernel's normal step meets the solid with a normal that differs on one side only), has a
 // colour that can go either way. Such pixels are reported apart instead of being counted as

@@ -1,7 +1,8 @@
 // The conformance suite on the gallery: every kernel backend (scalar, simd, opengl through
 // OSMesa, vulkan on lavapipe under the validation layer) x every gallery scene x every method,
-// at default parameters, measured against the oracle and judged by conformance/thresholds.json.
-// Labelled `conformance`. A backend that is unavailable here is skipped, with the reason.
+// at default parameters (float32, and float64 on the scalar backend), measured against the oracle
+// and judged by conformance/thresholds.json. Labelled `conformance`. A backend that is unavailable
+// here is skipped, with the reason.
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -17,10 +18,12 @@ namespace {
 struct Case {
   std::string backend, scene;
   Method method;
+  Precision precision = Precision::f32;
 };
 
 void PrintTo(const Case& c, std::ostream* os) {
-  *os << c.backend << " " << c.scene << " " << to_string(c.method);
+  *os << c.backend << " " << c.scene << " " << to_string(c.method)
+      << (c.precision == Precision::f64 ? " f64" : "");
 }
 
 const Backend& backend_named(const std::string& name) {
@@ -41,6 +44,7 @@ TEST_P(GalleryConformance, MeetsItsThresholds) {
   const Scene& scene = test::gallery_scene(GetParam().scene);
   MarchParams params;
   params.method = GetParam().method;
+  params.precision = GetParam().precision;
   Suite suite;
   const CaseResult r = suite.run(backend, scene, params, 160, 90);
   std::cout << "[ figures  ] " << to_json(r).dump() << "\n";
@@ -58,13 +62,17 @@ std::vector<Case> cases() {
     for (const std::string& name : test::gallery_names())
       for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
         all.push_back({backend, name, m});
+  for (const std::string& name : test::gallery_names())  // float64, on the reference CPU backend
+    for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
+      all.push_back({"scalar", name, m, Precision::f64});
   return all;
 }
 
 INSTANTIATE_TEST_SUITE_P(Gallery, GalleryConformance, testing::ValuesIn(cases()),
                          [](const testing::TestParamInfo<Case>& param) {
-                           return param.param.backend + "_" + param.param.scene + "_" +
-                                  to_string(param.param.method);
+                           return param.param.backend +
+                                  (param.param.precision == Precision::f64 ? "_f64_" : "_") +
+                                  param.param.scene + "_" + to_string(param.param.method);
                          });
 
 }  // namespace
