@@ -169,9 +169,16 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
         const Vec3 n(polygon.edges[static_cast<size_t>(e)].normal, 0.0);
         const double along = length > 0.0 ? glm::dot(n, step) / length : 0.0;
         drift += push * std::sqrt(std::max(0.0, 1.0 - along * along)) + 16.0 * u * scene.scale;
+        if (push > 0.0) truth.t_slack += params.eps / std::max(std::abs(along), 1e-3) + push;
         ++crossings;
         break;
       }
+  }
+  if (!r.path.empty() && (r.end.hit >= 0 || (r.end.hit == kHitWall && push > 0.0))) {
+    const Vec3 step = r.path.back().to - r.path.back().from;
+    const double length = glm::length(step);
+    const double cosine = length > 0.0 ? std::abs(glm::dot(step, r.end.normal)) / length : 1.0;
+    truth.t_slack += params.eps / std::max(cosine, 1e-3);
   }
   // t is summed step by step: in float32 it drifts by about 2^-24 of the distance a step. A ray
   // whose end lies that close to max_distance, on either side, may end either way.
@@ -199,6 +206,8 @@ FrameTruth frame_truth(const Scene& scene, const Camera& camera, int width, int 
   FrameTruth truth;
   truth.frame = Frame(width, height);
   truth.ambiguity.assign(static_cast<size_t>(width) * static_cast<size_t>(height), 0);
+  truth.t_slack.assign(truth.ambiguity.size(), 0.0f);
+  truth.unit_roundoff = unit_roundoff(params.precision);
   truth.delta = ambiguity_delta(scene, params);
   const CameraBasis<double> basis =
       camera_basis(camera.yaw_deg, camera.pitch_deg, camera.fov_deg, width, height);
@@ -209,6 +218,7 @@ FrameTruth frame_truth(const Scene& scene, const Camera& camera, int width, int 
       truth.frame.set(i, j, oracle_color(scene, r.end), r.end.steps, r.end.crossings, r.end.hit,
                       r.end.t);
       truth.ambiguity[truth.frame.pixel(i, j)] = r.ambiguity;
+      truth.t_slack[truth.frame.pixel(i, j)] = static_cast<float>(r.t_slack);
     }
   });
   return truth;

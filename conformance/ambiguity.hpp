@@ -53,6 +53,11 @@ double ambiguity_delta(const Scene& scene, const MarchParams& params);
 struct RayTruth {
   RayEnd end;
   uint8_t ambiguity = 0;  // Ambiguity bits; 0: the ray is decided
+  // How much shorter (or longer) the kernel's path length t may come out, rounding aside: at
+  // each crossing sphere tracing stops up to eps / cos(incidence) short of the edge and the push
+  // moves the point up to eps + offset along the ray; a solid (every method) or a wall (sphere,
+  // relaxed) is hit up to eps / cos(incidence) early.
+  double t_slack = 0.0;
 };
 
 // The oracle's answer for one ray, with its ambiguity at `delta` (max_distance from `params`).
@@ -62,7 +67,9 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
 struct FrameTruth {
   Frame frame;
   std::vector<uint8_t> ambiguity;  // a pixel's Ambiguity bits, row-major as the frame
+  std::vector<float> t_slack;      // a pixel's RayTruth::t_slack
   double delta = 0.0;
+  double unit_roundoff = 0.0;  // of the precision the frame is compared in
   size_t ambiguous() const;
 };
 

@@ -134,7 +134,11 @@ double AovComparison::crossings_rate() const {
   return decided() ? static_cast<double>(crossings_equal) / static_cast<double>(decided()) : 1.0;
 }
 
-AovComparison compare_aovs(const Frame& got, const FrameTruth& truth) {
+double AovComparison::t_exceeded_share() const {
+  return t_compared ? static_cast<double>(t_exceeded) / static_cast<double>(t_compared) : 0.0;
+}
+
+AovComparison compare_aovs(const Frame& got, const FrameTruth& truth, double scale) {
   AovComparison c;
   c.pixels = truth.frame.hit.size();
   for (size_t px = 0; px < c.pixels; ++px) {
@@ -151,6 +155,17 @@ AovComparison compare_aovs(const Frame& got, const FrameTruth& truth) {
     c.hit_equal += hit == want;
     c.crossings_equal += crossings == want_crossings;
     if (hit != want) ++c.confusion[{want, hit}];
+    if (hit == want && crossings == want_crossings && hit != kHitMiss && hit != kHitMaxSteps &&
+        hit != kHitVertex) {
+      const double t = static_cast<double>(truth.frame.t[px]);
+      const double allowed =
+          1.25 * static_cast<double>(truth.t_slack[px]) +
+          64.0 * truth.unit_roundoff * (t + scale) * (static_cast<double>(got.steps[px]) + 1.0);
+      const double error = std::abs(static_cast<double>(got.t[px]) - t);
+      ++c.t_compared;
+      c.t_exceeded += error > allowed;
+      c.t_worst = std::max(c.t_worst, error / allowed);
+    }
     if (const auto f = classify(hit, crossings, want, want_crossings))
       ++c.failures[static_cast<size_t>(*f)];
   }

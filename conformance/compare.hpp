@@ -70,7 +70,11 @@ struct AovComparison {
   size_t pixels = 0, ambiguous = 0;
   size_t hit_equal = 0;        // decided pixels whose hit is the oracle's
   size_t crossings_equal = 0;  // decided pixels whose crossings are the oracle's
-  FailureCounts failures{};    // decided pixels, by class
+  // t on the decided pixels that end as the oracle's, at a surface or escaping: |t - t'| against
+  // 1.25 times the truth's t_slack plus rounding, 64 u (t + scale) (steps + 1).
+  size_t t_compared = 0, t_exceeded = 0;
+  double t_worst = 0.0;                             // the largest |t - t'| / allowed
+  FailureCounts failures{};                         // decided pixels, by class
   std::map<std::pair<int, int>, size_t> confusion;  // (oracle's hit, got) -> decided pixels
   std::array<size_t, kAmbiguityReasons>
       ambiguity_reasons{};  // pixels with each Ambiguity bit, in bit order
@@ -78,8 +82,9 @@ struct AovComparison {
   size_t decided() const { return pixels - ambiguous; }
   double hit_rate() const;
   double crossings_rate() const;
+  double t_exceeded_share() const;
 };
-AovComparison compare_aovs(const Frame& got, const FrameTruth& truth);
+AovComparison compare_aovs(const Frame& got, const FrameTruth& truth, double scale);
 
 // --- Traces: the backend's events against the oracle's.
 struct TraceComparison {

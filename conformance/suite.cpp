@@ -145,12 +145,13 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   const Frame got = backend.render(scene, scene.camera, width, height, params, {});
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
-  r.aov = compare_aovs(got, exact);
+  r.aov = compare_aovs(got, exact, scene.scale);
   const double pixels = static_cast<double>(r.aov.pixels);
   const double decided = static_cast<double>(std::max<size_t>(r.aov.decided(), 1));
   add_check(r, "hit_rate", r.aov.hit_rate(), t.hit_rate, true);
   add_check(r, "crossings_rate", r.aov.crossings_rate(), t.crossings_rate, true);
   add_check(r, "ambiguous", static_cast<double>(r.aov.ambiguous) / pixels, t.ambiguous_max, false);
+  add_check(r, "t.exceeded", r.aov.t_exceeded_share(), t.t_exceeded_max, false);
   add_check(r, "most_steps", r.aov.most_steps, params.max_steps, false);
   for (int c = 0; c < kFailureClasses; ++c)
     add_check(r, std::string("failures.") + to_string(static_cast<Failure>(c)),
@@ -231,42 +232,45 @@ json to_json(const CaseResult& r) {
   const auto stats = [](const StepStats& s) {
     return json{{"mean", s.mean}, {"p50", s.p50}, {"p90", s.p90}, {"p99", s.p99}, {"max", s.max}};
   };
-  return {{"backend", r.backend},
-          {"scene", r.scene},
-          {"method", to_string(r.params.method)},
-          {"precision", r.params.precision == Precision::f32 ? "f32" : "f64"},
-          {"eps", r.params.eps},
-          {"offset", r.params.offset},
-          {"max_steps", r.params.max_steps},
-          {"max_distance", r.params.max_distance},
-          {"size", std::to_string(r.width) + "x" + std::to_string(r.height)},
-          {"passed", r.passed},
-          {"seconds", r.seconds},
-          {"delta", r.delta},
-          {"pixels", r.aov.pixels},
-          {"ambiguous", r.aov.ambiguous},
-          {"ambiguity", ambiguity},
-          {"hit_rate", r.aov.hit_rate()},
-          {"crossings_rate", r.aov.crossings_rate()},
-          {"failures", failures},
-          {"confusion", confusion},
-          {"image",
-           {{"mean_error", r.image.mean_error},
-            {"rms_error", r.image.rms_error},
-            {"psnr", r.image.psnr},
-            {"max_error", r.image.max_error},
-            {"max_at", {r.image.max_x, r.image.max_y}},
-            {"warn", r.image.warn},
-            {"fail", r.image.fail},
-            {"perceptual", r.image.perceptual}}},
-          {"steps", stats(r.steps)},
-          {"reference_steps", stats(r.reference_steps)},
-          {"steps_ks", r.steps_ks},
-          {"traces", traces},
-          {"trace_failures", trace_failures},
-          {"checks", checks},
-          {"warnings", r.warnings},
-          {"thresholds", to_json(r.thresholds)}};
+  return {
+      {"backend", r.backend},
+      {"scene", r.scene},
+      {"method", to_string(r.params.method)},
+      {"precision", r.params.precision == Precision::f32 ? "f32" : "f64"},
+      {"eps", r.params.eps},
+      {"offset", r.params.offset},
+      {"max_steps", r.params.max_steps},
+      {"max_distance", r.params.max_distance},
+      {"size", std::to_string(r.width) + "x" + std::to_string(r.height)},
+      {"passed", r.passed},
+      {"seconds", r.seconds},
+      {"delta", r.delta},
+      {"pixels", r.aov.pixels},
+      {"ambiguous", r.aov.ambiguous},
+      {"ambiguity", ambiguity},
+      {"hit_rate", r.aov.hit_rate()},
+      {"crossings_rate", r.aov.crossings_rate()},
+      {"t",
+       {{"compared", r.aov.t_compared}, {"exceeded", r.aov.t_exceeded}, {"worst", r.aov.t_worst}}},
+      {"failures", failures},
+      {"confusion", confusion},
+      {"image",
+       {{"mean_error", r.image.mean_error},
+        {"rms_error", r.image.rms_error},
+        {"psnr", r.image.psnr},
+        {"max_error", r.image.max_error},
+        {"max_at", {r.image.max_x, r.image.max_y}},
+        {"warn", r.image.warn},
+        {"fail", r.image.fail},
+        {"perceptual", r.image.perceptual}}},
+      {"steps", stats(r.steps)},
+      {"reference_steps", stats(r.reference_steps)},
+      {"steps_ks", r.steps_ks},
+      {"traces", traces},
+      {"trace_failures", trace_failures},
+      {"checks", checks},
+      {"warnings", r.warnings},
+      {"thresholds", to_json(r.thresholds)}};
 }
 
 }  // namespace flatmarch::conformance

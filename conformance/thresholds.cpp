@@ -63,6 +63,8 @@ void read(const json& j, Thresholds& t, const std::string& where) {
       t.crossings_rate = number(v, at, 0, 1);
     else if (key == "ambiguous_max")
       t.ambiguous_max = number(v, at, 0, 1);
+    else if (key == "t_exceeded_max")
+      t.t_exceeded_max = number(v, at, 0, 1);
     else if (key == "image")
       read_image(v, t.image, at);
     else if (key == "steps_ks_max")
@@ -186,6 +188,7 @@ json to_json(const Thresholds& t) {
   return {{"hit_rate", t.hit_rate},
           {"crossings_rate", t.crossings_rate},
           {"ambiguous_max", t.ambiguous_max},
+          {"t_exceeded_max", t.t_exceeded_max},
           {"image",
            {{"fail", t.image.fail},
             {"failpercent", t.image.failpercent},

@@ -18,6 +18,7 @@ struct Thresholds {
   double hit_rate = 0.999;       // decided pixels whose hit is the oracle's, at least
   double crossings_rate = 0.99;  // decided pixels whose crossings are the oracle's, at least
   double ambiguous_max = 0.25;   // share of ambiguous pixels, at most
+  double t_exceeded_max = 0.0;   // share of compared pixels whose t is off by more than allowed
   ImageThresholds image;
   double steps_ks_max = 0.05;          // Kolmogorov-Smirnov statistic against the reference
   double steps_mean_ratio_max = 1.05;  // mean steps within this factor of the reference's
