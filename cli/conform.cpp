@@ -15,12 +15,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A scene named by a file, or by its name in the gallery folder.
-fs::path scene_file(const std::string& name, const fs::path& gallery) {
+// A scene named by a file, or by its name in one of the gallery folders.
+fs::path scene_file(const std::string& name, const std::vector<std::string>& galleries) {
   if (fs::exists(name)) return name;
-  const fs::path in_gallery = gallery / (name + ".json");
-  if (fs::exists(in_gallery)) return in_gallery;
-  throw UsageError("--scene: no scene file \"" + name + "\" and no " + in_gallery.string());
+  for (const std::string& folder : galleries)
+    if (const fs::path in = fs::path(folder) / (name + ".json"); fs::exists(in)) return in;
+  throw UsageError("--scene: no scene file \"" + name + "\", nor " + name + ".json in " +
+                   (galleries.empty() ? std::string("any --gallery folder") : galleries.front()) +
+                   (galleries.size() > 1 ? " or the other --gallery folders" : ""));
 }
 
 std::string percent(double share) {
@@ -55,7 +57,8 @@ void add_conform(CLI::App& app) {
       "Prints a table, writes JSON; exits 1 when a case fails.");
   struct Options {
     std::vector<std::string> backends, scenes, methods;
-    std::string gallery = "scenes", size = "160x90", json = "conform.json", thresholds;
+    std::vector<std::string> galleries = {"scenes", "conformance/scenes"};
+    std::string size = "160x90", json = "conform.json", thresholds;
     std::string precision = "f32";
     MarchParams params;
     BackendOptions backend_options;
@@ -70,7 +73,10 @@ void add_conform(CLI::App& app) {
                   "whole gallery)");
   cmd->add_option("--method", o->methods,
                   "sphere, relaxed or analytic (repeat; default: all three)");
-  cmd->add_option("--gallery", o->gallery, "The gallery folder")->capture_default_str();
+  cmd->add_option("--gallery", o->galleries,
+                  "Folders of scenes, run whole when no --scene is given and searched for "
+                  "--scene names (repeat; default: scenes and conformance/scenes, the suite's own)")
+      ->capture_default_str();
   cmd->add_option("--size", o->size, "Frame size WxH")->capture_default_str();
   cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
   cmd->add_option("--thresholds", o->thresholds,
@@ -106,13 +112,20 @@ void add_conform(CLI::App& app) {
     }
     if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
     std::vector<fs::path> files;
-    for (const std::string& s : o->scenes) files.push_back(scene_file(s, o->gallery));
+    for (const std::string& s : o->scenes) files.push_back(scene_file(s, o->galleries));
     if (files.empty()) {
-      if (!fs::is_directory(o->gallery))
-        throw UsageError("--gallery: no folder " + o->gallery + " (give --scene or --gallery)");
-      for (const auto& entry : fs::directory_iterator(o->gallery))
-        if (entry.path().extension() == ".json") files.push_back(entry.path());
-      std::sort(files.begin(), files.end());
+      for (const std::string& folder : o->galleries) {
+        if (!fs::is_directory(folder)) continue;
+        std::vector<fs::path> in_folder;
+        for (const auto& entry : fs::directory_iterator(folder))
+          if (entry.path().extension() == ".json") in_folder.push_back(entry.path());
+        std::sort(in_folder.begin(), in_folder.end());
+        files.insert(files.end(), in_folder.begin(), in_folder.end());
+      }
+      if (files.empty())
+        throw UsageError("--gallery: no scene files in " + o->galleries.front() +
+                         (o->galleries.size() > 1 ? " or the other folders" : "") +
+                         " (run from the source folder, or give --scene or --gallery)");
     }
     std::vector<Scene> scenes;
     for (const fs::path& f : files) scenes.push_back(load_scene(f));

@@ -1,13 +1,17 @@
 // The conformance suite on the gallery: every kernel backend (scalar, simd, opengl through
-// OSMesa, vulkan on lavapipe under the validation layer) x every gallery scene x every method,
+// OSMesa, vulkan on lavapipe under the validation layer) x every scene of the gallery and of
+// conformance/scenes x every method,
 // at default parameters (float32, and float64 on the scalar backend), measured against the oracle
 // and judged by conformance/thresholds.json. Labelled `conformance`. A backend that is unavailable
 // here is skipped, with the reason.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <iostream>
+#include <map>
 
 #include "conformance/suite.hpp"
+#include "scene/load.hpp"
 #include "tests/gallery.hpp"
 #include "tests/opengl_backend.hpp"
 #include "tests/vulkan_backend.hpp"
@@ -26,6 +30,25 @@ void PrintTo(const Case& c, std::ostream* os) {
       << (c.precision == Precision::f64 ? " f64" : "");
 }
 
+// The gallery's scenes, then the suite's own (conformance/scenes: what the gallery lacks).
+std::vector<std::string> scene_names() {
+  std::vector<std::string> names = test::gallery_names();
+  for (const auto& entry : std::filesystem::directory_iterator(
+           std::filesystem::path(FLATMARCH_SOURCE_DIR) / "conformance" / "scenes"))
+    if (entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
+  return names;
+}
+
+const Scene& scene_named(const std::string& name) {
+  static std::map<std::string, Scene> own;
+  const auto file =
+      std::filesystem::path(FLATMARCH_SOURCE_DIR) / "conformance" / "scenes" / (name + ".json");
+  if (!std::filesystem::exists(file)) return test::gallery_scene(name);
+  auto it = own.find(name);
+  if (it == own.end()) it = own.emplace(name, load_scene(file)).first;
+  return it->second;
+}
+
 const Backend& backend_named(const std::string& name) {
   if (name == "opengl") return test::opengl();
   if (name == "vulkan") return test::vulkan();
@@ -41,7 +64,7 @@ TEST_P(GalleryConformance, MeetsItsThresholds) {
   const Backend& backend = backend_named(GetParam().backend);
   if (const Availability a = backend.availability(); !a.available)
     GTEST_SKIP() << "the " << GetParam().backend << " backend is unavailable here: " << a.reason;
-  const Scene& scene = test::gallery_scene(GetParam().scene);
+  const Scene& scene = scene_named(GetParam().scene);
   MarchParams params;
   params.method = GetParam().method;
   params.precision = GetParam().precision;
@@ -59,10 +82,10 @@ TEST_P(GalleryConformance, MeetsItsThresholds) {
 std::vector<Case> cases() {
   std::vector<Case> all;
   for (const std::string backend : {"scalar", "simd", "opengl", "vulkan"})
-    for (const std::string& name : test::gallery_names())
+    for (const std::string& name : scene_names())
       for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
         all.push_back({backend, name, m});
-  for (const std::string& name : test::gallery_names())  // float64, on the reference CPU backend
+  for (const std::string& name : scene_names())  // float64, on the reference CPU backend
     for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
       all.push_back({"scalar", name, m, Precision::f64});
   return all;
