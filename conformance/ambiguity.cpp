@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <tbb/parallel_for.h>
@@ -56,6 +57,45 @@ std::vector<int> solids_in(const Scene& scene, int p) {
 // The ambiguity of one room segment of the exact path, at `delta` (grown with the crossings so
 // far); `last` and `end` say whether and how the path ends with it, `crease` is the width over
 // which the kernel's normal (a finite difference) blurs an edge of a solid.
+// How a line o + s d, s in [0, length], passes a solid: how far it clears the solid's bounding
+// volume (0 if it enters it), and the sideways shift that takes it through the volume's centre
+// (its axis, for a vertex marker's cylinder).
+struct Approach {
+  double clearance = 0.0;
+  Vec3 towards{0.0};
+};
+
+Approach approach(const Scene& scene, int p, int index, Vec3 o, Vec3 d, double length) {
+  const int objects = static_cast<int>(scene.objects.size());
+  Approach best{std::numeric_limits<double>::infinity(), Vec3(0.0)};
+  const auto consider = [&](Vec3 centre, double radius, bool vertical) {
+    // The closest point of the line (in the plane for a vertical axis) within the segment.
+    const Vec3 w = centre - o;
+    const Vec3 along = vertical ? Vec3(d.x, d.y, 0.0) : d;
+    const double norm = glm::dot(along, along);
+    const double s =
+        norm > 0.0
+            ? std::clamp(glm::dot(vertical ? Vec3(w.x, w.y, 0.0) : w, along) / norm, 0.0, length)
+            : 0.0;
+    Vec3 off = centre - (o + s * d);
+    if (vertical) off.z = 0.0;
+    const double clearance = std::max(0.0, glm::length(off) - radius);
+    if (clearance < best.clearance) best = {clearance, off};
+  };
+  if (index < objects) {
+    const Object& object = scene.objects[static_cast<size_t>(index)];
+    const double h = std::max(object.z_max() - object.center.z, object.center.z - object.z_min());
+    consider(object.center, std::hypot(object.footprint_radius(), h), false);
+  } else {
+    const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
+    for (int v = 0; v < polygon.size(); ++v)
+      if (scene.marker_at(p, v) == index - objects)
+        consider(Vec3(polygon.vertex(v), 0.0),
+                 scene.markers[static_cast<size_t>(index - objects)].radius, true);
+  }
+  return best;
+}
+
 uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last, const RayEnd& end,
                           double delta, double eps, double crease) {
   const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
@@ -98,16 +138,31 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
     // Every method stops within eps of a solid: a line passing that close counts as a hit.
     const double shifted = delta + eps;
     const double limit = length + shifted + (exact ? scene.scale : 0.0);
-    // Eight directions 45 degrees apart, 1.1 times as far: whichever way the nearest point of
-    // the solid lies, one of them moves the line at least `shifted` towards it (cos 22.5 > 1/1.1).
+    // A solid whose bounding volume the line clears by more than that cannot be grazed.
+    const Approach near = approach(scene, seg.polygon, index, seg.from, d, length);
+    if (!exact && near.clearance > shifted) continue;
+    // Shifts in eight directions 45 degrees apart, half and 1.1 times as far (whichever way the
+    // nearest point of the solid lies, one of them moves the line at least `shifted` towards it:
+    // cos 22.5 > 1/1.1), and towards the solid's centre, in quarters and right through it, so
+    // that a solid smaller than the shift is not jumped over.
+    std::vector<Vec3> shifts;
     for (int k = 0; k < 8; ++k) {
       const double a = kPi / 4.0 * k;
-      const Vec3 shift = 1.1 * shifted * (std::cos(a) * e1 + std::sin(a) * e2);
+      const Vec3 dir = std::cos(a) * e1 + std::sin(a) * e2;
+      shifts.push_back(0.55 * shifted * dir);
+      shifts.push_back(1.1 * shifted * dir);
+    }
+    const double gap = glm::length(near.towards);
+    if (gap > 0.0) {
+      for (const double f : {0.25, 0.5, 0.75, 1.0})
+        shifts.push_back(std::min(f * 1.1 * shifted, gap) * near.towards / gap);
+      if (gap <= 1.1 * shifted) shifts.push_back(near.towards);
+    }
+    for (const Vec3& shift : shifts)
       if (meet(scene, seg.polygon, index, seg.from + shift, d, limit).has_value() != exact) {
         bits |= kSilhouette;
         break;
       }
-    }
     // At an edge of the solid the normal, and so the colour, jumps: a hit within the kernel's
     // normal step of one is a crease.
     if (!exact || (bits & kSilhouette)) continue;
