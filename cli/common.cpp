@@ -113,6 +113,16 @@ void check_march_params(const MarchParams& params) {
                  "ray that reaches a gluing ends with max_steps\n";
 }
 
+void warn_about_resolution(const Scene& scene, const MarchParams& params) {
+  const double resolution = 0x1p-23 * scene.scale;
+  if (params.precision == Precision::f32 && params.method != Method::analytic &&
+      params.eps < resolution)
+    std::cerr << "warning: " << scene.name << ": --eps " << params.eps
+              << " is below float32's resolution at this scene's scale (" << resolution
+              << "): sphere tracing gets that close to a wall only by landing on it, and many "
+                 "rays run out of steps; use --precision f64 or a larger eps\n";
+}
+
 const Backend& MarchOptions::resolve() {
   if (backend.empty()) {
     const Backend* preferred = find_backend(default_backend);

@@ -36,6 +36,10 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
 // Throws UsageError for parameters out of range; warns (stderr) when offset <= eps.
 void check_march_params(const MarchParams& params);
 
+// Warns (stderr) when params.eps lies below float32's resolution at the scene's scale, where
+// sphere tracing cannot get within eps of a wall but by landing on it.
+void warn_about_resolution(const Scene& scene, const MarchParams& params);
+
 // The backend and march parameters of render and trace (DESIGN.md section 3).
 struct MarchOptions {
   std::string backend;  // empty: default_backend

@@ -129,6 +129,12 @@ void add_conform(CLI::App& app) {
     }
     std::vector<Scene> scenes;
     for (const fs::path& f : files) scenes.push_back(load_scene(f));
+    if (std::any_of(methods.begin(), methods.end(), [](Method m) { return m != Method::analytic; }))
+      for (const Scene& scene : scenes) {
+        MarchParams sphere = o->params;
+        sphere.method = Method::sphere;
+        warn_about_resolution(scene, sphere);
+      }
     if (o->backends.empty()) o->backends = {"scalar", "simd", "opengl", "vulkan"};
     nlohmann::json thresholds = conformance::builtin_thresholds();
     if (!o->thresholds.empty()) {

@@ -31,6 +31,7 @@ void add_render(CLI::App& app) {
     const Backend& backend = o->march.resolve();
     const Scene scene = load_scene(o->scene);
     const Camera camera = o->camera.apply(scene);
+    warn_about_resolution(scene, o->march.params);
     const auto start = std::chrono::steady_clock::now();
     ProgressReporter progress("rendering " + scene.name + " " + o->size + " with " + backend.name(),
                               o->quiet);

@@ -298,6 +298,12 @@ TEST(CliConform, PrintsATableWritesJsonAndExitsByTheVerdict) {
   EXPECT_NE(r.out.find("ambiguous"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("1 of 1 cases failed"), std::string::npos) << r.err;
 
+  // eps below float32's resolution at the torus's scale (4 * 2^-23): a warning that says why.
+  r = test::run_flatmarch({"conform", "--backend", "scalar", "--scene", torus, "--method",
+                           "analytic", "--method", "sphere", "--eps", "1e-9", "--offset", "2e-9",
+                           "--size", "16x9", "--json", json});
+  EXPECT_NE(r.err.find("below float32's resolution"), std::string::npos) << r.err;
+
   r = test::run_flatmarch({"conform", "--backend", "nonesuch", "--scene", torus});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("unknown backend"), std::string::npos) << r.err;
