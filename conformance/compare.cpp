@@ -33,6 +33,33 @@ double quantile(const std::vector<float>& sorted, double q) {
   return static_cast<double>(sorted[k]);
 }
 
+// The hit code a final event stands for; nothing for a crossing.
+std::optional<int> end_code(const Event& e) {
+  switch (e.kind) {
+    case EventKind::object:
+      return e.object;
+    case EventKind::wall:
+      return kHitWall;
+    case EventKind::floor:
+      return kHitFloor;
+    case EventKind::escape:
+      return kHitEscape;
+    case EventKind::vertex:
+      return kHitVertex;
+    case EventKind::max_steps:
+      return kHitMaxSteps;
+    case EventKind::max_distance:
+      return kHitMaxDistance;
+    case EventKind::miss:
+      return kHitMiss;
+    case EventKind::gluing:
+    case EventKind::mirror:
+    case EventKind::enter:
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 const char* to_string(Failure f) {
@@ -216,44 +243,22 @@ TraceComparison compare_traces(const Scene& scene, const Trace& got, const Trace
   if (c.leak) {
     c.failure = Failure::leak;
   } else if (c.first_divergence >= 0) {
-    const Event& e = a[static_cast<size_t>(c.first_divergence)];
-    const Event& w = b[static_cast<size_t>(c.first_divergence)];
-    const auto end_code = [](const Event& x) {
-      switch (x.kind) {
-        case EventKind::object:
-          return x.object;
-        case EventKind::wall:
-          return kHitWall;
-        case EventKind::floor:
-          return kHitFloor;
-        case EventKind::escape:
-          return kHitEscape;
-        case EventKind::vertex:
-          return kHitVertex;
-        case EventKind::max_steps:
-          return kHitMaxSteps;
-        case EventKind::max_distance:
-          return kHitMaxDistance;
-        case EventKind::miss:
-          return kHitMiss;
-        default:
-          return 1000;  // a crossing: not an end
-      }
-    };
-    const int hit = end_code(e), want = end_code(w);
-    c.failure = (hit == 1000 && want == 1000) ? Failure::wrong_edge
-                                              : classify(hit, 0, want, hit == want ? 0 : 1);
-    if (!c.failure) c.failure = Failure::wrong_edge;
-    // One side crossed where the other ended: classify by what the ending side did.
-    if (hit == 1000 && want != 1000)
-      c.failure = is_object(want)   ? Failure::missed_object
-                  : is_escape(want) ? Failure::late_escape
-                                    : Failure::wrong_edge;
-    if (want == 1000 && hit != 1000)
-      c.failure = hit == kHitMaxSteps ? Failure::stuck
-                  : is_object(hit)    ? Failure::phantom_hit
-                  : is_escape(hit)    ? Failure::early_escape
-                                      : Failure::wrong_edge;
+    const std::optional<int> hit = end_code(a[static_cast<size_t>(c.first_divergence)]);
+    const std::optional<int> want = end_code(b[static_cast<size_t>(c.first_divergence)]);
+    if (hit && want) {  // both ended, differently: as a pixel would be classed
+      c.failure = classify(*hit, 0, *want, *hit == *want ? 1 : 0).value_or(Failure::wrong_edge);
+    } else if (want) {  // the backend went on where the oracle ended
+      c.failure = is_object(*want)   ? Failure::missed_object
+                  : is_escape(*want) ? Failure::late_escape
+                                     : Failure::wrong_edge;
+    } else if (hit) {  // the backend ended where the oracle went on
+      c.failure = *hit == kHitMaxSteps ? Failure::stuck
+                  : is_object(*hit)    ? Failure::phantom_hit
+                  : is_escape(*hit)    ? Failure::early_escape
+                                       : Failure::wrong_edge;
+    } else {  // both crossed, through different edges
+      c.failure = Failure::wrong_edge;
+    }
   } else if (c.length_differs) {
     c.failure = a.size() < b.size() && !a.empty() && a.back().kind == EventKind::max_steps
                     ? Failure::stuck
