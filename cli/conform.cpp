@@ -54,7 +54,10 @@ void add_conform(CLI::App& app) {
       "metric), its step counts against the scalar backend in float64, and the traces of generic\n"
       "probe rays; failures are classed (stuck, wrong_edge, missed_object, phantom_hit,\n"
       "early_escape, late_escape, leak). Each case is judged by conformance/thresholds.json.\n"
-      "Prints a table, writes JSON; exits 1 when a case fails.");
+      "Prints a table, writes JSON; exits 1 when a case fails. Columns: ambig% pixels the mask\n"
+      "leaves undecided; hit% and cross% decided pixels whose hit and crossings are the oracle's;\n"
+      "img% pixels over idiff's fail threshold; stepKS the steps' distance from float64's;\n"
+      "traces probe rays diverged / traced; failures the rays of each class.");
   struct Options {
     std::vector<std::string> backends, scenes, methods;
     std::vector<std::string> galleries = {"scenes", "conformance/scenes"};
@@ -69,8 +72,8 @@ void add_conform(CLI::App& app) {
                   "Backend to measure (repeat for more; default: every kernel backend, those "
                   "unavailable here skipped with the reason)");
   cmd->add_option("--scene", o->scenes,
-                  "Scene file, or a scene's name in the gallery folder (repeat; default: the "
-                  "whole gallery)");
+                  "Scene file, or a scene's name in a --gallery folder (repeat; default: every "
+                  "scene of the --gallery folders)");
   cmd->add_option("--method", o->methods,
                   "sphere, relaxed or analytic (repeat; default: all three)");
   cmd->add_option("--gallery", o->galleries,
