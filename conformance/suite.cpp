@@ -116,14 +116,21 @@ const Frame& Suite::reference(const Scene& scene, const MarchParams& params, int
   return it->second;
 }
 
-const std::vector<std::pair<Ray, Trace>>& Suite::probes(const Scene& scene, int count, int events) {
-  const std::string k = scene.name + "|" + std::to_string(count) + "|" + std::to_string(events);
-  auto it = probes_.find(k);
+const std::vector<std::pair<Ray, Trace>>& Suite::probes(const Scene& scene, int count, int events,
+                                                        double max_distance) {
+  std::ostringstream k;
+  k.precision(17);
+  k << scene.name << "|" << count << "|" << events << "|" << max_distance;
+  auto it = probes_.find(k.str());
   if (it == probes_.end()) {
+    MarchParams exact;  // the oracle, as far as the case's rays go
+    exact.method = Method::oracle;
+    exact.max_distance = max_distance;
+    exact.max_steps = 100000;
     std::vector<std::pair<Ray, Trace>> list;
     for (const Ray& ray : probe_rays(scene, count, events))
-      list.emplace_back(ray, oracle_trace(scene, ray, {}, {.max_events = events}).trace);
-    it = probes_.emplace(k, std::move(list)).first;
+      list.emplace_back(ray, oracle_trace(scene, ray, exact, {.max_events = events}).trace);
+    it = probes_.emplace(k.str(), std::move(list)).first;
   }
   return it->second;
 }
@@ -180,7 +187,7 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
 
   int diverged = 0;
   double trace_error = 0.0;
-  for (const auto& [ray, want] : probes(scene, t.probe_rays, t.trace_events)) {
+  for (const auto& [ray, want] : probes(scene, t.probe_rays, t.trace_events, params.max_distance)) {
     const Trace trace = backend.trace(scene, ray, params, t.trace_events);
     TraceComparison c = compare_traces(scene, trace, want, params.eps);
     if (c.failure) {

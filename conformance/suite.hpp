@@ -64,7 +64,8 @@ class Suite {
  private:
   const FrameTruth& truth(const Scene& scene, const MarchParams& params, int width, int height);
   const Frame& reference(const Scene& scene, const MarchParams& params, int width, int height);
-  const std::vector<std::pair<Ray, Trace>>& probes(const Scene& scene, int count, int events);
+  const std::vector<std::pair<Ray, Trace>>& probes(const Scene& scene, int count, int events,
+                                                   double max_distance);
 
   nlohmann::json thresholds_;
   std::map<std::string, FrameTruth> truths_;
