@@ -33,7 +33,28 @@ double quantile(const std::vector<float>& sorted, double q) {
   return static_cast<double>(sorted[k]);
 }
 
-// The hit code a final event stands for; nothing for a crossing.
+}  // namespace
+
+const char* to_string(Failure f) {
+  switch (f) {
+    case Failure::stuck:
+      return "stuck";
+    case Failure::wrong_edge:
+      return "wrong_edge";
+    case Failure::missed_object:
+      return "missed_object";
+    case Failure::phantom_hit:
+      return "phantom_hit";
+    case Failure::early_escape:
+      return "early_escape";
+    case Failure::late_escape:
+      return "late_escape";
+    case Failure::leak:
+      return "leak";
+  }
+  return "?";
+}
+
 std::optional<int> end_code(const Event& e) {
   switch (e.kind) {
     case EventKind::object:
@@ -58,28 +79,6 @@ std::optional<int> end_code(const Event& e) {
       return std::nullopt;
   }
   return std::nullopt;
-}
-
-}  // namespace
-
-const char* to_string(Failure f) {
-  switch (f) {
-    case Failure::stuck:
-      return "stuck";
-    case Failure::wrong_edge:
-      return "wrong_edge";
-    case Failure::missed_object:
-      return "missed_object";
-    case Failure::phantom_hit:
-      return "phantom_hit";
-    case Failure::early_escape:
-      return "early_escape";
-    case Failure::late_escape:
-      return "late_escape";
-    case Failure::leak:
-      return "leak";
-  }
-  return "?";
 }
 
 std::optional<Failure> classify(int hit, int crossings, int want, int want_crossings) {

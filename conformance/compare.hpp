@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -101,6 +102,9 @@ struct TraceComparison {
 // `eps` bounds how far outside its room an event may lie before it counts as a leak.
 TraceComparison compare_traces(const Scene& scene, const Trace& got, const Trace& truth,
                                double eps);
+
+// The hit code (as in the hit AOV) a final event stands for; nothing for a crossing.
+std::optional<int> end_code(const Event& e);
 
 // One line describing an event: kind, room, edge or object.
 std::string describe(const Event& e);

@@ -11,10 +11,9 @@
 #include <map>
 
 #include "conformance/suite.hpp"
+#include "conformance/tests/test_backends.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
-#include "tests/opengl_backend.hpp"
-#include "tests/vulkan_backend.hpp"
 
 namespace flatmarch::conformance {
 namespace {
@@ -49,19 +48,10 @@ const Scene& scene_named(const std::string& name) {
   return it->second;
 }
 
-const Backend& backend_named(const std::string& name) {
-  if (name == "opengl") return test::opengl();
-  if (name == "vulkan") return test::vulkan();
-  static std::map<std::string, std::unique_ptr<Backend>> made;
-  auto& b = made[name];
-  if (!b) b = make_backend(name, {});
-  return *b;
-}
-
 class GalleryConformance : public testing::TestWithParam<Case> {};
 
 TEST_P(GalleryConformance, MeetsItsThresholds) {
-  const Backend& backend = backend_named(GetParam().backend);
+  const Backend& backend = test::backend_named(GetParam().backend);
   if (const Availability a = backend.availability(); !a.available)
     GTEST_SKIP() << "the " << GetParam().backend << " backend is unavailable here: " << a.reason;
   const Scene& scene = scene_named(GetParam().scene);

@@ -15,11 +15,10 @@
 #include "backends/oracle/oracle.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "conformance/suite.hpp"
+#include "conformance/tests/test_backends.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
-#include "tests/opengl_backend.hpp"
 #include "tests/test_scenes.hpp"
-#include "tests/vulkan_backend.hpp"
 
 namespace flatmarch::conformance {
 namespace {
@@ -38,19 +37,10 @@ const Backend& f64_kernel() {
   return std::find(p.begin(), p.end(), Precision::f64) != p.end() ? *g_kernel : scalar;
 }
 
-const Backend& backend_named(const std::string& name) {
-  if (name == "opengl") return test::opengl();
-  if (name == "vulkan") return test::vulkan();
-  static std::map<std::string, std::unique_ptr<Backend>> made;
-  auto& b = made[name];
-  if (!b) b = make_backend(name, {});
-  return *b;
-}
-
 class Stability : public testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
-    g_kernel = &backend_named(GetParam());
+    g_kernel = &test::backend_named(GetParam());
     if (const Availability a = g_kernel->availability(); !a.available)
       GTEST_SKIP() << "the " << GetParam() << " backend is unavailable here: " << a.reason;
   }
@@ -83,25 +73,7 @@ uint8_t ambiguity(const Scene& scene, const Ray& ray, const MarchParams& p) {
 
 int kernel_hit(const Scene& scene, const Ray& ray, const MarchParams& p) {
   const Trace t = kernel().trace(scene, ray, p, 5000);
-  const Event& e = t.events.back();
-  switch (e.kind) {
-    case EventKind::object:
-      return e.object;
-    case EventKind::wall:
-      return kHitWall;
-    case EventKind::floor:
-      return kHitFloor;
-    case EventKind::escape:
-      return kHitEscape;
-    case EventKind::vertex:
-      return kHitVertex;
-    case EventKind::max_steps:
-      return kHitMaxSteps;
-    case EventKind::max_distance:
-      return kHitMaxDistance;
-    default:
-      return kHitMiss;
-  }
+  return end_code(t.events.back()).value_or(kHitMiss);  // cut short: no end
 }
 
 // --- Grazing rays along walls -----------------------------------------------------------------
