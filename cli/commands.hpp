@@ -15,5 +15,8 @@ void add_import_peer(CLI::App& app);
 void add_shader(CLI::App& app);
 void add_view(CLI::App& app);
 void add_conform(CLI::App& app);
+void add_report(CLI::App& app);
+void add_select(CLI::App& app);
+void add_sweep(CLI::App& app);
 
 }  // namespace flatmarch::cli

@@ -2,14 +2,17 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
 #include "backends/oracle/oracle.hpp"
 #include "backends/simd/simd.hpp"
+#include "scene/load.hpp"
 
 namespace flatmarch::cli {
 
@@ -190,6 +193,47 @@ Camera CameraOptions::apply(const Scene& scene) const {
   if (auto problem = ray_problem(scene, Ray{c.polygon, c.position, Vec3(1.0, 0.0, 0.0)}))
     throw UsageError("camera: " + *problem);
   return c;
+}
+
+namespace {
+
+// A scene named by a file, or by its name in one of the gallery folders.
+std::filesystem::path scene_file(const std::string& name,
+                                 const std::vector<std::string>& galleries) {
+  if (std::filesystem::exists(name)) return name;
+  for (const std::string& folder : galleries)
+    if (const std::filesystem::path in = std::filesystem::path(folder) / (name + ".json");
+        std::filesystem::exists(in))
+      return in;
+  throw UsageError("--scene: no scene file \"" + name + "\", nor " + name + ".json in " +
+                   (galleries.empty() ? std::string("any --gallery folder") : galleries.front()) +
+                   (galleries.size() > 1 ? " or the other --gallery folders" : ""));
+}
+
+}  // namespace
+
+std::vector<Scene> load_scenes(const std::vector<std::string>& names,
+                               const std::vector<std::string>& galleries) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> files;
+  for (const std::string& s : names) files.push_back(scene_file(s, galleries));
+  if (files.empty()) {
+    for (const std::string& folder : galleries) {
+      if (!fs::is_directory(folder)) continue;
+      std::vector<fs::path> in_folder;
+      for (const auto& entry : fs::directory_iterator(folder))
+        if (entry.path().extension() == ".json") in_folder.push_back(entry.path());
+      std::sort(in_folder.begin(), in_folder.end());
+      files.insert(files.end(), in_folder.begin(), in_folder.end());
+    }
+    if (files.empty())
+      throw UsageError("--gallery: no scene files in " + galleries.front() +
+                       (galleries.size() > 1 ? " or the other folders" : "") +
+                       " (run from the source folder, or give --scene or --gallery)");
+  }
+  std::vector<Scene> scenes;
+  for (const fs::path& f : files) scenes.push_back(load_scene(f));
+  return scenes;
 }
 
 ProgressReporter::ProgressReporter(std::string label, bool quiet)

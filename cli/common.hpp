@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -32,6 +33,12 @@ class ConformanceFailure : public std::runtime_error {
 
 Vec3 parse_vec3(const std::string& option, const std::string& text);
 std::pair<int, int> parse_size(const std::string& option, const std::string& text);
+
+// The scenes named by --scene (a file, or a scene's name in one of the --gallery folders) or,
+// when none is named, every scene of the folders, each folder's sorted by file name. UsageError
+// when a name is found nowhere or the folders hold no scene.
+std::vector<Scene> load_scenes(const std::vector<std::string>& names,
+                               const std::vector<std::string>& galleries);
 
 // Throws UsageError for parameters out of range; warns (stderr) when offset <= eps.
 void check_march_params(const MarchParams& params);

@@ -15,16 +15,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A scene named by a file, or by its name in one of the gallery folders.
-fs::path scene_file(const std::string& name, const std::vector<std::string>& galleries) {
-  if (fs::exists(name)) return name;
-  for (const std::string& folder : galleries)
-    if (const fs::path in = fs::path(folder) / (name + ".json"); fs::exists(in)) return in;
-  throw UsageError("--scene: no scene file \"" + name + "\", nor " + name + ".json in " +
-                   (galleries.empty() ? std::string("any --gallery folder") : galleries.front()) +
-                   (galleries.size() > 1 ? " or the other --gallery folders" : ""));
-}
-
 std::string percent(double share) {
   char s[32];
   std::snprintf(s, sizeof s, "%.3f", 100.0 * share);
@@ -114,24 +104,7 @@ void add_conform(CLI::App& app) {
       methods.push_back(*m);
     }
     if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
-    std::vector<fs::path> files;
-    for (const std::string& s : o->scenes) files.push_back(scene_file(s, o->galleries));
-    if (files.empty()) {
-      for (const std::string& folder : o->galleries) {
-        if (!fs::is_directory(folder)) continue;
-        std::vector<fs::path> in_folder;
-        for (const auto& entry : fs::directory_iterator(folder))
-          if (entry.path().extension() == ".json") in_folder.push_back(entry.path());
-        std::sort(in_folder.begin(), in_folder.end());
-        files.insert(files.end(), in_folder.begin(), in_folder.end());
-      }
-      if (files.empty())
-        throw UsageError("--gallery: no scene files in " + o->galleries.front() +
-                         (o->galleries.size() > 1 ? " or the other folders" : "") +
-                         " (run from the source folder, or give --scene or --gallery)");
-    }
-    std::vector<Scene> scenes;
-    for (const fs::path& f : files) scenes.push_back(load_scene(f));
+    const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
     if (std::any_of(methods.begin(), methods.end(), [](Method m) { return m != Method::analytic; }))
       for (const Scene& scene : scenes) {
         MarchParams sphere = o->params;

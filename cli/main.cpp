@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
   cli::add_shader(app);
   cli::add_view(app);
   cli::add_conform(app);
+  cli::add_report(app);
+  cli::add_select(app);
+  cli::add_sweep(app);
   // CLI11 would only say that a subcommand is required.
   const auto subcommands = app.get_subcommands([](const CLI::App*) { return true; });
   const auto known = [&](const char* name) {

@@ -97,10 +97,15 @@ Suite::Suite(json thresholds) : thresholds_(std::move(thresholds)) {}
 const FrameTruth& Suite::truth(const Scene& scene, const MarchParams& params, int width,
                                int height) {
   // The mask depends on the method: the analytic method crosses edges without a push.
-  const std::string k = key(scene, params, width, height, true);
+  MarchParams masked = params;
+  if (mask_) {
+    masked.eps = mask_->eps;
+    masked.offset = mask_->offset;
+  }
+  const std::string k = key(scene, masked, width, height, true);
   auto it = truths_.find(k);
   if (it == truths_.end())
-    it = truths_.emplace(k, frame_truth(scene, scene.camera, width, height, params)).first;
+    it = truths_.emplace(k, frame_truth(scene, scene.camera, width, height, masked)).first;
   return it->second;
 }
 

@@ -60,6 +60,11 @@ class Suite {
   CaseResult run(const Backend& backend, const Scene& scene, const MarchParams& params, int width,
                  int height);
   const nlohmann::json& thresholds() const { return thresholds_; }
+  // Judges every later case against the oracle's truth masked as for `mask.eps` and
+  // `mask.offset` (each case keeps its method and precision), not as for the case's own: a sweep
+  // over eps and offset then measures each point against one truth, and a large eps cannot
+  // widen the mask over the pixels it gets wrong.
+  void fix_mask(const MarchParams& mask) { mask_ = mask; }
 
  private:
   const FrameTruth& truth(const Scene& scene, const MarchParams& params, int width, int height);
@@ -68,6 +73,7 @@ class Suite {
                                                    double max_distance);
 
   nlohmann::json thresholds_;
+  std::optional<MarchParams> mask_;
   std::map<std::string, FrameTruth> truths_;
   std::map<std::string, Frame> references_;
   std::map<std::string, std::vector<std::pair<Ray, Trace>>> probes_;

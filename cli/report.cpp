@@ -1,0 +1,406 @@
+// `flatmarch report`, `flatmarch select` and `flatmarch sweep`: the suite's answers for its
+// users — which backend is fastest here, which parameters are safe, and did anything get worse.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "cli/commands.hpp"
+#include "cli/common.hpp"
+#include "reports/fingerprint.hpp"
+#include "reports/report.hpp"
+#include "reports/surfaces.hpp"
+#include "scene/load.hpp"
+
+namespace flatmarch::cli {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+json read_json(const std::string& option, const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw UsageError(option + ": cannot read " + file.string());
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw UsageError(option + ": " + file.string() + " is not JSON: " + e.what());
+  }
+}
+
+void write_json(const fs::path& file, const json& doc) {
+  if (file.has_parent_path()) fs::create_directories(file.parent_path());
+  std::ofstream out(file);
+  out << doc.dump(1) << "\n";
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+std::vector<Method> parse_methods(const std::vector<std::string>& names) {
+  std::vector<Method> methods;
+  for (const std::string& name : names) {
+    const auto m = parse_method(name);
+    if (!m || *m == Method::oracle)
+      throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + name + "\"");
+    methods.push_back(*m);
+  }
+  if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
+  return methods;
+}
+
+// Charts and the page, by reports/make_report.py with matplotlib.
+void make_html(const std::string& python, const std::vector<std::string>& results,
+               const fs::path& out) {
+  std::string command = "'" + python + "' '" FLATMARCH_SOURCE_DIR "/reports/make_report.py' -o '" +
+                        out.string() + "'";
+  for (const std::string& r : results) command += " '" + r + "'";
+  if (std::system(command.c_str()) != 0)
+    throw std::runtime_error(
+        "the charts and the page could not be made (" + command +
+        " failed; it needs python3 with matplotlib: ci/install-deps.sh installs it); the results "
+        "are in " +
+        results.front());
+}
+
+// Progress of the report's stages on stderr, one reporter per stage.
+struct StageProgress {
+  bool quiet;
+  std::string stage;
+  std::unique_ptr<ProgressReporter> reporter;
+  void operator()(const std::string& s, const std::string& line, int done, int total) {
+    if (quiet) return;
+    if (s != stage) {
+      if (reporter) reporter->done();
+      stage = s;
+      reporter = std::make_unique<ProgressReporter>("report: " + s);
+    }
+    if (total == 0) std::fprintf(stderr, "report: %s\n", line.c_str());
+    if (total > 0) (*reporter)(static_cast<double>(done) / total);
+  }
+};
+
+std::string default_python() {
+  if (const char* p = std::getenv("FLATMARCH_PYTHON")) return p;
+  return "/usr/bin/python3";
+}
+
+}  // namespace
+
+void add_report(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "report",
+      "The main job: measure every available backend on the gallery — each scene and method timed\n"
+      "(Google Benchmark, median of repetitions) and measured against the oracle (the conformance\n"
+      "suite) — sweep eps x offset per surface type, time the scaling series (resolution, edges,\n"
+      "path length), and write OUT/results.json (with this machine's fingerprint) and a\n"
+      "self-contained OUT/index.html: gallery images per backend, speed against accuracy,\n"
+      "stability and step heatmaps, failure tables, scaling curves, the ranking of backends and\n"
+      "recommended parameters. The quick default takes a few minutes on 2 cores; --full measures\n"
+      "more. Given result files (RESULTS...), measures nothing: one file makes its page again,\n"
+      "several compare their machines. --baseline checks the deterministic figures (steps,\n"
+      "crossings, conformance rates) against committed ones: exit 1 when one regresses beyond its\n"
+      "tolerance; slower timings only warn.");
+  struct Options {
+    std::vector<std::string> results, backends, scenes, methods;
+    std::vector<std::string> galleries = {"scenes"};
+    std::string out = "reports/out", size, conform_size = "160x90", sweep_size, sweep_backend;
+    std::string baseline, write_baseline, python = default_python();
+    int repetitions = 0;
+    double min_time = 0.05;
+    bool full = false, no_sweep = false, no_scaling = false, no_html = false, quiet = false;
+    MarchParams params;
+    BackendOptions backend_options;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("RESULTS", o->results,
+                  "Result files of earlier runs (results.json): page of one, comparison of several")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--out", o->out, "Output folder")->capture_default_str();
+  cmd->add_flag("--full", o->full,
+                "The full matrix: frames 640x360, 5 repetitions, the sweep on every scene, longer "
+                "scaling series on every backend");
+  cmd->add_option("--backend", o->backends,
+                  "Backend to measure (repeat; default: scalar, simd, opengl, vulkan — those "
+                  "unavailable here skipped with the reason)");
+  cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
+  cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
+  cmd->add_option("--method", o->methods, "sphere, relaxed or analytic (repeat; default: all)");
+  cmd->add_option("--size", o->size, "Timed frames WxH (default 320x180; --full 640x360)");
+  cmd->add_option("--conform-size", o->conform_size, "Frames measured against the oracle")
+      ->capture_default_str();
+  cmd->add_option("--repetitions", o->repetitions,
+                  "Timed repetitions per case (default 3; --full 5)");
+  cmd->add_option("--min-time", o->min_time, "Seconds per repetition, at least one frame")
+      ->capture_default_str();
+  cmd->add_option("--sweep-backend", o->sweep_backend,
+                  "Backend of the sweep (default scalar: the only one with f64)");
+  cmd->add_option("--sweep-size", o->sweep_size, "Sweep frames WxH (default 64x36; --full 96x54)");
+  cmd->add_flag("--no-sweep", o->no_sweep, "Skip the eps x offset sweep");
+  cmd->add_flag("--no-scaling", o->no_scaling, "Skip the scaling series");
+  cmd->add_flag("--no-html", o->no_html, "Write results.json only");
+  cmd->add_option("--baseline", o->baseline,
+                  "Check against this baseline (reports/baseline.json): exit 1 on a regression")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--write-baseline", o->write_baseline,
+                  "Write this run's deterministic figures as a baseline file");
+  cmd->add_option("--python", o->python, "python3 with matplotlib (env FLATMARCH_PYTHON)")
+      ->capture_default_str();
+  cmd->add_option("--eps", o->params.eps, "Hit threshold of the matrix")->capture_default_str();
+  cmd->add_option("--offset", o->params.offset, "Re-entry push of the matrix")
+      ->capture_default_str();
+  cmd->add_option("--max-steps", o->params.max_steps, "Kernel iterations before a ray gives up")
+      ->capture_default_str();
+  cmd->add_option("--isa", o->backend_options.isa, "simd: the instruction set");
+  cmd->add_option("--threads", o->backend_options.threads, "simd: worker threads (0: all cores)");
+  cmd->add_option("--device", o->backend_options.device, "vulkan: the device");
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress");
+  cmd->callback([o] {
+    if (!o->results.empty()) {
+      if (!o->baseline.empty() || !o->write_baseline.empty())
+        throw UsageError("--baseline and --write-baseline measure: give no RESULTS with them");
+      if (o->results.size() == 1)
+        for (const char* key : {"fingerprint", "matrix", "ranking"})
+          if (!read_json("RESULTS", o->results[0]).contains(key))
+            throw UsageError("RESULTS: " + o->results[0] + " has no \"" + key +
+                             "\": not a results file of `flatmarch report`");
+      make_html(o->python, o->results, o->out);
+      std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
+      return;
+    }
+    check_march_params(o->params);
+    reports::ReportOptions r;
+    r.matrix.params = o->params;
+    r.matrix.backend_options = o->backend_options;
+    r.matrix.methods = parse_methods(o->methods);
+    if (!o->backends.empty()) r.matrix.backends = o->backends;
+    for (const std::string& b : r.matrix.backends) {
+      if (b == "oracle")
+        throw UsageError("--backend: the oracle is what the others are measured against");
+      if (!make_backend(b, o->backend_options))
+        throw UsageError("--backend: unknown backend \"" + b + "\" (see `flatmarch backends`)");
+    }
+    std::tie(r.matrix.width, r.matrix.height) =
+        parse_size("--size", o->size.empty() ? (o->full ? "640x360" : "320x180") : o->size);
+    std::tie(r.matrix.conform_width, r.matrix.conform_height) =
+        parse_size("--conform-size", o->conform_size);
+    r.matrix.repetitions = o->repetitions ? o->repetitions : (o->full ? 5 : 3);
+    if (r.matrix.repetitions < 2 || r.matrix.repetitions > 100)
+      throw UsageError("--repetitions: expected 2 to 100");
+    if (!(o->min_time > 0.0 && o->min_time <= 10.0))
+      throw UsageError("--min-time: expected seconds in (0, 10]");
+    r.matrix.min_time = o->min_time;
+    r.matrix.conformance = true;
+    r.matrix.images = o->no_html ? fs::path() : fs::path(o->out) / "images";
+    const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
+
+    r.sweep_enabled = !o->no_sweep;
+    r.sweep_all_scenes = o->full;
+    r.sweep.methods = r.matrix.methods;
+    r.sweep.params.max_steps = o->params.max_steps;
+    r.sweep.backend_options = o->backend_options;
+    if (!o->sweep_backend.empty()) r.sweep.backend = o->sweep_backend;
+    std::tie(r.sweep.width, r.sweep.height) = parse_size(
+        "--sweep-size", o->sweep_size.empty() ? (o->full ? "96x54" : "64x36") : o->sweep_size);
+
+    r.scaling_enabled = !o->no_scaling;
+    r.scaling.methods = r.matrix.methods;
+    r.scaling.backend_options = o->backend_options;
+    for (const Scene& s : scenes)
+      if (s.name == "torus") r.scaling.resolution_scene = s;
+    if (o->full) {
+      r.scaling.backends = r.matrix.backends;
+      r.scaling.polygon_n.clear();
+      for (int n = 2; n <= 32; ++n) r.scaling.polygon_n.push_back(n);
+      r.scaling.staircase_squares = {2, 4, 8, 16, 32, 64};
+      r.scaling.resolutions = {{80, 45}, {160, 90}, {320, 180}, {640, 360}, {1280, 720}};
+      r.scaling.max_distances = {10, 20, 40, 80, 160, 320};
+    } else {
+      r.scaling.backends = {"scalar", "simd"};
+    }
+
+    StageProgress progress{o->quiet, "", nullptr};
+    const json results = reports::run_report(scenes, r, std::ref(progress));
+    if (progress.reporter) progress.reporter->done();
+    const fs::path file = fs::path(o->out) / "results.json";
+    write_json(file, results);
+    std::printf("%s", reports::describe_selection(results, "").c_str());
+    std::printf("report: wrote %s\n", file.c_str());
+    if (!o->write_baseline.empty()) {
+      write_json(o->write_baseline, reports::make_baseline(results));
+      std::printf("report: wrote the baseline %s\n", o->write_baseline.c_str());
+    }
+    if (!o->no_html) {
+      make_html(o->python, {file.string()}, o->out);
+      std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
+    }
+    if (!o->baseline.empty()) {
+      const json baseline = read_json("--baseline", o->baseline);
+      if (baseline.value("format", "") != "flatmarch-baseline/1")
+        throw UsageError("--baseline: " + o->baseline + " is not a baseline file");
+      for (const char* key : {"size", "conform_size", "eps", "offset", "max_steps"})
+        if (baseline["options"][key] != results["options"][key])
+          throw UsageError("--baseline: it was measured with " + std::string(key) + " " +
+                           baseline["options"][key].dump() + ", this run with " +
+                           results["options"][key].dump() + "; measure alike");
+      const json check = reports::check_baseline(baseline, results);
+      write_json(fs::path(o->out) / "gate.json", check);
+      for (const json& w : check["timing_warnings"])
+        std::printf("warning: %s is slower: %.3g ms against %.3g ms (x%.2f, Mann-Whitney p=%.3g)\n",
+                    w["case"].get<std::string>().c_str(), w["now_ms"].get<double>(),
+                    w["was_ms"].get<double>(), w["ratio"].get<double>(),
+                    w["p_value"].get<double>());
+      if (!check["same_machine"].get<bool>() && !check["timing_warnings"].empty())
+        std::printf(
+            "warning: the baseline's timings come from another CPU (%s): compare with "
+            "care\n",
+            reports::describe_machine(baseline["fingerprint"]).c_str());
+      for (const json& m : check["missing"])
+        std::printf("warning: %s is in the baseline but was not measured\n",
+                    m.get<std::string>().c_str());
+      for (const json& i : check["improvements"])
+        std::printf("improved: %s %s %s -> %s (update the baseline: --write-baseline)\n",
+                    i["case"].get<std::string>().c_str(), i["figure"].get<std::string>().c_str(),
+                    i["was"].dump().c_str(), i["now"].dump().c_str());
+      for (const json& g : check["regressions"])
+        std::printf("REGRESSION: %s %s %s -> %s (tolerance %s)\n",
+                    g["case"].get<std::string>().c_str(), g["figure"].get<std::string>().c_str(),
+                    g["was"].dump().c_str(), g["now"].dump().c_str(),
+                    g.value("tolerance", json(0)).dump().c_str());
+      std::printf(
+          "gate: %d cases compared with %s: %zu regressions, %zu improvements, %zu timing "
+          "warnings, %zu missing\n",
+          check["compared"].get<int>(), o->baseline.c_str(), check["regressions"].size(),
+          check["improvements"].size(), check["timing_warnings"].size(), check["missing"].size());
+      if (!check["regressions"].empty())
+        throw ConformanceFailure(std::to_string(check["regressions"].size()) +
+                                 " figures regressed against " + o->baseline);
+    }
+  });
+}
+
+void add_select(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "select",
+      "Print the backend, method and parameters `flatmarch report` chose for this machine, from\n"
+      "its results file: the fastest backend of those that passed every conformance case, its\n"
+      "fastest conforming method, and eps and offset per surface type from the sweep.");
+  struct Options {
+    std::string results = "reports/out/results.json", scene;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("RESULTS", o->results, "A results file of `flatmarch report`")
+      ->capture_default_str();
+  cmd->add_option("--scene", o->scene,
+                  "A scene file: print only the parameters for its surface type");
+  cmd->callback([o] {
+    if (!fs::exists(o->results))
+      throw UsageError("RESULTS: no " + o->results + "; run `flatmarch report` first");
+    const json results = read_json("RESULTS", o->results);
+    if (!results.contains("recommendation") || !results.contains("fingerprint"))
+      throw UsageError("RESULTS: " + o->results + " is not a results file of `flatmarch report`");
+    const std::string type = o->scene.empty() ? "" : reports::surface_type(load_scene(o->scene));
+    std::printf("%s", reports::describe_selection(results, type).c_str());
+  });
+}
+
+void add_sweep(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "sweep",
+      "March each scene over a grid of eps (1e-1 ... 1e-7) and offsets (0.5 ... 10 x eps, and\n"
+      "fixed values) for each method and precision, measuring time, steps and accuracy against\n"
+      "the oracle (conformance verdict, hit mismatch, trace agreement, failures by class). Per\n"
+      "surface type it prints the stable region (every scene passes), the speed-accuracy Pareto\n"
+      "front and the recommended eps and offset; writes everything as JSON.");
+  struct Options {
+    std::vector<std::string> scenes, methods, precisions;
+    std::vector<std::string> galleries = {"scenes"};
+    std::string size = "64x36", json = "sweep.json";
+    reports::SweepOptions sweep;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
+  cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
+  cmd->add_option("--backend", o->sweep.backend, "Backend to sweep")->capture_default_str();
+  cmd->add_option("--method", o->methods, "sphere, relaxed or analytic (repeat; default: all)");
+  cmd->add_option("--precision", o->precisions, "f32 or f64 (repeat; default: those it has)");
+  cmd->add_option("--eps", o->sweep.eps, "The eps values")->capture_default_str();
+  cmd->add_option("--offset-factor", o->sweep.offset_factors, "Offsets as multiples of eps")
+      ->capture_default_str();
+  cmd->add_option("--offset-fixed", o->sweep.offset_fixed, "Fixed offsets")->capture_default_str();
+  cmd->add_option("--size", o->size, "Frame size WxH")->capture_default_str();
+  cmd->add_option("--repetitions", o->sweep.repetitions, "Frames timed per point (median)")
+      ->capture_default_str();
+  cmd->add_option("--max-steps", o->sweep.params.max_steps, "Kernel iterations")
+      ->capture_default_str();
+  cmd->add_option("--isa", o->sweep.backend_options.isa, "simd: the instruction set");
+  cmd->add_option("--device", o->sweep.backend_options.device, "vulkan: the device");
+  cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress");
+  cmd->callback([o] {
+    std::tie(o->sweep.width, o->sweep.height) = parse_size("--size", o->size);
+    o->sweep.methods = parse_methods(o->methods);
+    if (!o->precisions.empty()) {
+      o->sweep.precisions.clear();
+      for (const std::string& p : o->precisions) {
+        if (p != "f32" && p != "f64")
+          throw UsageError("--precision: expected f32 or f64, got \"" + p + "\"");
+        o->sweep.precisions.push_back(p == "f32" ? Precision::f32 : Precision::f64);
+      }
+    }
+    for (double e : o->sweep.eps)
+      if (!(e > 0.0 && e < 1.0)) throw UsageError("--eps: values must lie in (0, 1)");
+    for (double f : o->sweep.offset_factors)
+      if (!(f > 0.0 && f <= 1000.0)) throw UsageError("--offset-factor: values in (0, 1000]");
+    for (double f : o->sweep.offset_fixed)
+      if (!(f > 0.0 && f < 1.0)) throw UsageError("--offset-fixed: values must lie in (0, 1)");
+    if (o->sweep.repetitions < 1 || o->sweep.repetitions > 100)
+      throw UsageError("--repetitions: expected 1 to 100");
+    if (o->sweep.params.max_steps < 1 || o->sweep.params.max_steps > (1 << 20))
+      throw UsageError("--max-steps: expected 1 to 1048576");
+    if (!make_backend(o->sweep.backend, o->sweep.backend_options) || o->sweep.backend == "oracle")
+      throw UsageError("--backend: expected scalar, simd, opengl or vulkan, got \"" +
+                       o->sweep.backend + "\"");
+    const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
+    conformance::Suite suite;
+    ProgressReporter progress("sweep", o->quiet);
+    json result;
+    try {
+      result =
+          reports::run_sweep(scenes, o->sweep, suite, [&](const std::string&, int done, int total) {
+            progress(static_cast<double>(done) / total);
+          });
+    } catch (const std::invalid_argument& e) {
+      throw UnavailableError(e.what());
+    }
+    progress.done();
+    result["fingerprint"] = reports::hardware_fingerprint();
+    write_json(o->json, result);
+    std::printf("%-12s %-9s %-4s %7s  %-26s %s\n", "surface", "method", "prec", "stable",
+                "recommended eps / offset", "pareto front (eps, offset: ms, hit mismatch %)");
+    for (const json& g : result["analysis"]) {
+      std::string rec = "-";
+      if (!g["recommended"].is_null()) {
+        char s[64];
+        std::snprintf(s, sizeof s, "%g / %g", g["recommended"]["eps"].get<double>(),
+                      g["recommended"]["offset"].get<double>());
+        rec = s;
+      }
+      std::string front;
+      for (const json& p : g["pareto"]) {
+        char s[96];
+        std::snprintf(s, sizeof s, "%s%g,%s: %.2g, %.2g", front.empty() ? "" : "; ",
+                      p["eps"].get<double>(), p["offset_label"].get<std::string>().c_str(),
+                      p["time_ms"].get<double>(), 100.0 * p["hit_mismatch"].get<double>());
+        front += s;
+      }
+      std::printf("%-12s %-9s %-4s %3zu/%-3zu  %-26s %s\n",
+                  g["surface_type"].get<std::string>().c_str(),
+                  g["method"].get<std::string>().c_str(), g["precision"].get<std::string>().c_str(),
+                  g["stable"].size(), g["grid"].size(), rec.c_str(), front.c_str());
+    }
+    std::printf("wrote %s\n", o->json.c_str());
+  });
+}
+
+}  // namespace flatmarch::cli

@@ -1,0 +1,19 @@
+// The machine a result was measured on, carried by every result file: CPU model and instruction
+// sets, GPUs and drivers (OpenGL's renderer, the Vulkan device), the operating system, the
+// libraries' versions and the build.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+namespace flatmarch::reports {
+
+nlohmann::json hardware_fingerprint();
+
+// One line: CPU model, cores, ISA; the Vulkan device; OpenGL's renderer.
+std::string describe_machine(const nlohmann::json& fingerprint);
+
+// Adds the fingerprint's fields to Google Benchmark's context ("fingerprint.cpu.model", ...), so
+// that the JSON of the benchmark programs carries it too.
+void add_to_benchmark_context(const nlohmann::json& fingerprint);
+
+}  // namespace flatmarch::reports

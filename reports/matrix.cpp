@@ -1,0 +1,282 @@
+#include "reports/matrix.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <numeric>
+#include <regex>
+#include <sstream>
+
+#include "backends/simd/simd.hpp"
+#include "output/image_io.hpp"
+#include "reports/surfaces.hpp"
+
+namespace flatmarch::reports {
+
+using nlohmann::json;
+
+json accuracy_summary(const conformance::CaseResult& r) {
+  json failures = json::object();
+  size_t total = 0;
+  for (int c = 0; c < conformance::kFailureClasses; ++c) {
+    const size_t n =
+        r.aov.failures[static_cast<size_t>(c)] + r.trace_failures[static_cast<size_t>(c)];
+    failures[conformance::to_string(static_cast<conformance::Failure>(c))] = n;
+    total += n;
+  }
+  int diverged = 0;
+  for (const auto& t : r.traces) diverged += t.failure.has_value();
+  json failed = json::array();
+  for (const conformance::Check& c : r.checks)
+    if (!c.passed) failed.push_back(c.name);
+  const double pixels = static_cast<double>(std::max<size_t>(r.aov.pixels, 1));
+  return {{"passed", r.passed},
+          {"hit_mismatch", 1.0 - r.aov.hit_rate()},
+          {"crossings_mismatch", 1.0 - r.aov.crossings_rate()},
+          {"ambiguous", static_cast<double>(r.aov.ambiguous) / pixels},
+          {"image_fail", static_cast<double>(r.image.fail) /
+                             static_cast<double>(std::max<size_t>(r.image.pixels, 1))},
+          {"image_mean_error", r.image.mean_error},
+          {"traces", r.traces.size()},
+          {"traces_diverged", diverged},
+          {"failures", failures},
+          {"failures_total", total},
+          {"steps_ks", r.steps_ks},
+          {"failed_checks", r.failed_checks()},
+          {"failed", failed}};
+}
+
+std::string case_name(const std::string& backend, Method method, const std::string& scene,
+                      int width, int height) {
+  return backend + "/" + to_string(method) + "/" + scene + "/" + std::to_string(width) + "x" +
+         std::to_string(height);
+}
+
+namespace {
+
+void frame_counters(benchmark::State& state, const Frame& frame) {
+  std::vector<float> steps(frame.steps.begin(), frame.steps.end());
+  std::sort(steps.begin(), steps.end());
+  const double pixels = static_cast<double>(steps.size());
+  state.counters["rays_per_s"] =
+      benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["steps_mean"] = std::accumulate(steps.begin(), steps.end(), 0.0) / pixels;
+  state.counters["steps_p99"] = steps[static_cast<size_t>(0.99 * (pixels - 1))];
+  state.counters["crossings_mean"] =
+      std::accumulate(frame.crossings.begin(), frame.crossings.end(), 0.0) / pixels;
+  state.counters["out_of_steps"] =
+      static_cast<double>(std::count(frame.hit.begin(), frame.hit.end(), float(kHitMaxSteps))) /
+      pixels;
+}
+
+// Collects Google Benchmark's JSON and says when each run ends.
+class CollectingReporter : public benchmark::JSONReporter {
+ public:
+  CollectingReporter(std::ostream& out, std::function<void(const std::string&)> on_run)
+      : on_run_(std::move(on_run)) {
+    SetOutputStream(&out);
+    SetErrorStream(&errors_);
+  }
+  void ReportRuns(const std::vector<Run>& runs) override {
+    JSONReporter::ReportRuns(runs);
+    for (const Run& run : runs)
+      if (run.run_type == Run::RT_Aggregate && run.aggregate_name == "median" && on_run_)
+        on_run_(run.run_name.str());
+  }
+
+ private:
+  std::ostringstream errors_;
+  std::function<void(const std::string&)> on_run_;
+};
+
+}  // namespace
+
+void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
+                              const MarchParams& params, int width, int height, int repetitions,
+                              double min_time, Frame* last, const std::string& name) {
+  const auto* simd = dynamic_cast<const SimdBackend*>(&backend);
+  auto warmed = std::make_shared<bool>(false);
+  benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
+      (name.empty() ? case_name(backend.name(), params.method, scene.name, width, height) : name)
+          .c_str(),
+      [&backend, &scene, camera, params, width, height, last, simd,
+       warmed](benchmark::State& state) {
+        // A backend's error (a failed compile, a lost device) ends the case, not the run.
+        Frame f;
+        try {
+          if (!*warmed) f = backend.render(scene, camera, width, height, params, {});
+          *warmed = true;
+          for (auto _ : state) {
+            f = backend.render(scene, camera, width, height, params, {});
+            benchmark::DoNotOptimize(f.rgb.data());
+          }
+          if (simd) {
+            simd::LaneCounts lanes;
+            simd->render_counted(scene, camera, width, height, params, {}, lanes);
+            state.counters["lane_utilisation"] =
+                static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
+          }
+        } catch (const std::exception& e) {
+          state.SkipWithError(e.what());
+          return;
+        }
+        frame_counters(state, f);
+        if (last) *last = std::move(f);
+      })
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+  if (min_time > 0.0) b->MinTime(min_time);
+  if (repetitions > 0) b->Repetitions(repetitions);
+}
+
+json run_registered_benchmarks(const std::function<void(const std::string&)>& on_run) {
+  std::ostringstream out;
+  CollectingReporter reporter(out, on_run);
+  benchmark::RunSpecifiedBenchmarks(&reporter, ".*");
+  benchmark::ClearRegisteredBenchmarks();
+  // Google Benchmark writes NaN for a coefficient of variation of zeros (a counter that is 0 in
+  // every repetition); JSON has no NaN, so it is read as null.
+  static const std::regex not_a_number(R"((:\s*)-?(NaN|nan|inf)\b)");
+  return json::parse(std::regex_replace(out.str(), not_a_number, "$1null"));
+}
+
+std::map<std::string, Timing> timings(const json& document) {
+  std::map<std::string, Timing> result;
+  const auto ms = [](const json& run) {
+    const std::string unit = run.value("time_unit", "ns");
+    const double scale = unit == "ms" ? 1.0 : unit == "us" ? 1e-3 : unit == "s" ? 1e3 : 1e-6;
+    return run.at("real_time").get<double>() * scale;
+  };
+  for (const json& run : document.value("benchmarks", json::array())) {
+    // Google Benchmark appends the case's settings to the name it was registered with.
+    static const std::regex settings(R"(/(min_time|repeats|iterations|threads):[^/]*|/real_time)");
+    const std::string name =
+        std::regex_replace(run.value("run_name", run.value("name", "")), settings, "");
+    Timing& t = result[name];
+    if (run.value("error_occurred", false)) {
+      t.error = run.value("error_message", "error");
+      continue;
+    }
+    const bool aggregate = run.value("run_type", "iteration") == "aggregate";
+    if (!aggregate) t.samples_ms.push_back(ms(run));
+    if (aggregate && run.value("aggregate_name", "") != "median") continue;
+    if (aggregate) t.median_ms = ms(run);
+    json counters = json::object();
+    for (const auto& [key, value] : run.items())
+      if (value.is_number() && key != "real_time" && key != "cpu_time" && key != "iterations" &&
+          key != "repetitions" && key != "repetition_index" && key != "threads" &&
+          key != "family_index" && key != "per_family_instance_index")
+        counters[key] = value;
+    if (aggregate || t.counters.is_null()) t.counters = counters;
+  }
+  for (auto& [name, t] : result)
+    if (t.median_ms == 0.0 && !t.samples_ms.empty()) {
+      std::vector<double> s = t.samples_ms;
+      std::nth_element(s.begin(), s.begin() + static_cast<long>(s.size() / 2), s.end());
+      t.median_ms = s[s.size() / 2];
+    }
+  return result;
+}
+
+json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, conformance::Suite& suite,
+                const MatrixProgress& progress) {
+  json out = {{"cases", json::array()}, {"skipped", json::array()}};
+  std::vector<std::unique_ptr<Backend>> backends;
+  for (const std::string& name : o.backends) {
+    std::unique_ptr<Backend> b = make_backend(name, o.backend_options);
+    if (!b) throw std::invalid_argument("unknown backend \"" + name + "\"");
+    const Availability a = b->availability();
+    const std::vector<Precision> p = b->precisions();
+    std::string skip = a.available ? "" : "unavailable here: " + a.reason;
+    if (skip.empty() && std::find(p.begin(), p.end(), o.params.precision) == p.end())
+      skip = "does not march in this precision";
+    if (!skip.empty()) {
+      out["skipped"].push_back({{"backend", name}, {"reason", skip}});
+      if (progress) progress(name + " skipped: " + skip, 0, 0);
+      continue;
+    }
+    backends.push_back(std::move(b));
+  }
+  const int total = static_cast<int>(backends.size() * scenes.size() * o.methods.size());
+  std::map<std::string, json> cases;
+  std::vector<std::string> order;
+  // Frames kept for the gallery images, by case name (sphere method only).
+  std::map<std::string, Frame> frames;
+  for (const auto& backend : backends)
+    for (const Scene& scene : scenes)
+      for (const Method m : o.methods) {
+        MarchParams params = o.params;
+        params.method = m;
+        const std::string name = case_name(backend->name(), m, scene.name, o.width, o.height);
+        order.push_back(name);
+        cases[name] = {{"name", name},           {"backend", backend->name()},
+                       {"scene", scene.name},    {"surface_type", surface_type(scene)},
+                       {"method", to_string(m)}, {"width", o.width},
+                       {"height", o.height}};
+        if (o.timing) {
+          Frame* keep = nullptr;
+          if (!o.images.empty() && m == o.methods.front()) keep = &frames[name];
+          register_frame_benchmark(*backend, scene, scene.camera, params, o.width, o.height,
+                                   o.repetitions, o.min_time, keep);
+        }
+      }
+  int done = 0;
+  if (o.conformance)
+    for (const auto& backend : backends)
+      for (const Scene& scene : scenes)
+        for (const Method m : o.methods) {
+          MarchParams params = o.params;
+          params.method = m;
+          const std::string name = case_name(backend->name(), m, scene.name, o.width, o.height);
+          json& c = cases[name];
+          try {
+            c["accuracy"] = accuracy_summary(
+                suite.run(*backend, scene, params, o.conform_width, o.conform_height));
+            c["accuracy"]["size"] =
+                std::to_string(o.conform_width) + "x" + std::to_string(o.conform_height);
+          } catch (const std::exception& e) {
+            c["error"] = e.what();
+          }
+          if (progress)
+            progress("conformance " + name + (c.contains("error") ? ": error" : ""), ++done,
+                     o.timing ? 2 * total : total);
+        }
+  if (o.timing) {
+    out["benchmarks"] = run_registered_benchmarks([&](const std::string& name) {
+      if (progress) progress("timed " + name, ++done, o.conformance ? 2 * total : total);
+    });
+    for (const auto& [name, t] : timings(out["benchmarks"])) {
+      if (!cases.count(name)) continue;
+      json& c = cases[name];
+      if (!t.error.empty()) {
+        c["error"] = t.error;
+        continue;
+      }
+      c["time_ms"] = t.median_ms;
+      c["time_samples_ms"] = t.samples_ms;
+      c["counters"] = t.counters;
+    }
+  }
+  for (const std::string& name : order) out["cases"].push_back(cases[name]);
+  // The truth beside them.
+  if (!o.images.empty())
+    if (const Backend* oracle = find_backend("oracle"))
+      for (const Scene& scene : scenes) {
+        MarchParams params = o.params;
+        params.method = Method::oracle;
+        const std::filesystem::path png = o.images / "oracle" / (scene.name + ".png");
+        std::filesystem::create_directories(png.parent_path());
+        write_png(oracle->render(scene, scene.camera, o.width, o.height, params, {}), png);
+      }
+  for (const auto& [name, frame] : frames) {
+    if (frame.width == 0) continue;
+    const json& c = cases[name];
+    const std::filesystem::path png =
+        o.images / c["backend"].get<std::string>() / (c["scene"].get<std::string>() + ".png");
+    std::filesystem::create_directories(png.parent_path());
+    write_png(frame, png);
+  }
+  return out;
+}
+
+}  // namespace flatmarch::reports

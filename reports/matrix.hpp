@@ -1,0 +1,76 @@
+// The report's matrix: every backend x gallery scene x method, timed by Google Benchmark (its
+// JSON, with the hardware fingerprint in its context, is the exchange format) and measured
+// against the oracle by the conformance suite.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "backends/backend.hpp"
+#include "conformance/suite.hpp"
+
+namespace flatmarch::reports {
+
+struct MatrixOptions {
+  std::vector<std::string> backends = {"scalar", "simd", "opengl", "vulkan"};
+  BackendOptions backend_options;
+  std::vector<Method> methods = {Method::sphere, Method::relaxed, Method::analytic};
+  MarchParams params;             // eps, offset, ...; the method is each case's
+  int width = 320, height = 180;  // timed frames
+  int conform_width = 160, conform_height = 90;
+  int repetitions = 3;      // Google Benchmark repetitions of each timed case
+  double min_time = 0.05;   // seconds per repetition, at least one frame
+  bool conformance = true;  // measure against the oracle too
+  bool timing = true;
+  // Where to write each backend's frame of each scene (sphere method) as BACKEND/SCENE.png; empty:
+  // nowhere.
+  std::filesystem::path images;
+};
+
+// Called with a line of progress: what was done, how many of how many.
+using MatrixProgress = std::function<void(const std::string& line, int done, int total)>;
+
+// The summary of a conformance case the report shows: passed, hit_mismatch and
+// crossings_mismatch (shares of decided pixels), ambiguous (share of pixels), image_fail (share),
+// image_mean_error, traces and traces_diverged, failures by class and failures_total, steps_ks,
+// failed_checks (a line each) and failed (the names of the failed checks).
+nlohmann::json accuracy_summary(const conformance::CaseResult& r);
+
+// Runs the matrix. Returns {"benchmarks": Google Benchmark's JSON document, "cases": one per
+// backend x scene x method with its timing (median and samples, ms), counters and accuracy,
+// "skipped": backends unavailable here with the reason}.
+nlohmann::json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& options,
+                          conformance::Suite& suite, const MatrixProgress& progress);
+
+// Runs Google Benchmark on what is registered now, collecting its JSON (with the context, where
+// the fingerprint is added) and calling `on_run` with each run's name as it ends; clears the
+// registrations after.
+nlohmann::json run_registered_benchmarks(const std::function<void(const std::string&)>& on_run);
+
+// Registers one timed case, BACKEND/METHOD/SCENE/WxH: frames of the scene's camera, after one
+// untimed frame (GPU backends compile the scene's program then); counters rays_per_s,
+// steps_mean, steps_p99, crossings_mean, out_of_steps and, for the SIMD backend, lane_utilisation.
+// `last`, when given, receives the last frame. Repetitions and min_time of 0 leave them to
+// Google Benchmark's flags (--benchmark_repetitions, --benchmark_min_time).
+void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
+                              const MarchParams& params, int width, int height, int repetitions,
+                              double min_time, Frame* last = nullptr, const std::string& name = "");
+
+// The name register_frame_benchmark gives.
+std::string case_name(const std::string& backend, Method method, const std::string& scene,
+                      int width, int height);
+
+// The median and the per-repetition times (ms) of each run name in a Google Benchmark document.
+struct Timing {
+  double median_ms = 0.0;
+  std::vector<double> samples_ms;
+  nlohmann::json counters;  // of the median aggregate (or the only run)
+  std::string error;        // the backend's error, when the case could not run
+};
+std::map<std::string, Timing> timings(const nlohmann::json& benchmark_document);
+
+}  // namespace flatmarch::reports

@@ -1,0 +1,367 @@
+#include "reports/report.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <map>
+#include <set>
+
+#include "reports/fingerprint.hpp"
+#include "reports/surfaces.hpp"
+
+namespace flatmarch::reports {
+
+using nlohmann::json;
+
+namespace {
+
+std::string now_utc() {
+  const std::time_t t = std::time(nullptr);
+  char s[32];
+  std::strftime(s, sizeof s, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return s;
+}
+
+std::string number(double v) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%g", v);
+  return s;
+}
+
+}  // namespace
+
+json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
+                const ReportProgress& progress) {
+  json results = {{"format", "flatmarch-report/1"}, {"created", now_utc()}};
+  results["fingerprint"] = hardware_fingerprint();
+  add_to_benchmark_context(results["fingerprint"]);
+  results["options"] = {
+      {"size", std::to_string(o.matrix.width) + "x" + std::to_string(o.matrix.height)},
+      {"conform_size",
+       std::to_string(o.matrix.conform_width) + "x" + std::to_string(o.matrix.conform_height)},
+      {"repetitions", o.matrix.repetitions},
+      {"eps", o.matrix.params.eps},
+      {"offset", o.matrix.params.offset},
+      {"max_steps", o.matrix.params.max_steps},
+      {"max_distance", o.matrix.params.max_distance},
+      {"scenes", json::array()}};
+  for (const Scene& s : scenes) results["options"]["scenes"].push_back(s.name);
+  conformance::Suite suite;
+  auto started = std::chrono::steady_clock::now();
+  // Seconds since the last call: the time each stage took.
+  const auto lap = [&started] {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - started).count();
+    started = now;
+    return s;
+  };
+  results["seconds"] = json::object();
+  results["matrix"] =
+      run_matrix(scenes, o.matrix, suite, [&](const std::string& line, int done, int total) {
+        if (progress) progress("matrix", line, done, total);
+      });
+  results["seconds"]["matrix"] = lap();
+  if (o.sweep_enabled) {
+    std::vector<Scene> chosen;
+    std::set<std::string> types;
+    for (const Scene& s : scenes)
+      if (o.sweep_all_scenes || types.insert(surface_type(s)).second) chosen.push_back(s);
+    results["sweep"] =
+        run_sweep(chosen, o.sweep, suite, [&](const std::string& line, int done, int total) {
+          if (progress) progress("sweep", line, done, total);
+        });
+  }
+  results["seconds"]["sweep"] = lap();
+  if (o.scaling_enabled)
+    results["scaling"] = run_scaling(o.scaling, [&](const std::string& line, int done, int total) {
+      if (progress) progress("scaling", line, done, total);
+    });
+  results["seconds"]["scaling"] = lap();
+  results["ranking"] = rank_backends(results["matrix"]);
+  results["recommendation"] = recommend(results["ranking"], results.value("sweep", json::object()));
+  return results;
+}
+
+json rank_backends(const json& matrix) {
+  struct Tally {
+    int cases = 0, passed = 0, errors = 0;
+    double log_rays = 0.0;
+    int timed = 0;
+    std::map<std::string, std::array<double, 4>> methods;  // cases, passed, log rays, timed
+  };
+  std::map<std::string, Tally> tallies;
+  std::vector<std::string> order;
+  for (const json& c : matrix.value("cases", json::array())) {
+    const std::string b = c["backend"];
+    if (!tallies.count(b)) order.push_back(b);
+    Tally& t = tallies[b];
+    auto& m = t.methods[c["method"].get<std::string>()];
+    ++t.cases;
+    m[0] += 1;
+    if (c.contains("error")) {
+      ++t.errors;
+      continue;
+    }
+    const bool passed = !c.contains("accuracy") || c["accuracy"]["passed"].get<bool>();
+    t.passed += passed;
+    m[1] += passed;
+    if (c.contains("counters") && c["counters"].value("rays_per_s", 0.0) > 0.0) {
+      const double l = std::log(c["counters"]["rays_per_s"].get<double>());
+      t.log_rays += l;
+      ++t.timed;
+      m[2] += l;
+      m[3] += 1;
+    }
+  }
+  json ranking = json::array();
+  for (const std::string& b : order) {
+    const Tally& t = tallies[b];
+    json methods = json::object();
+    std::string best;
+    double best_rays = 0.0;
+    for (const auto& [name, m] : t.methods) {
+      const double rays = m[3] > 0 ? std::exp(m[2] / m[3]) : 0.0;
+      const bool conforms = m[1] == m[0];
+      methods[name] = {
+          {"cases", m[0]}, {"passed", m[1]}, {"rays_per_s", rays}, {"conforms", conforms}};
+      if (conforms && rays > best_rays) {
+        best = name;
+        best_rays = rays;
+      }
+    }
+    ranking.push_back({{"backend", b},
+                       {"cases", t.cases},
+                       {"passed", t.passed},
+                       {"errors", t.errors},
+                       {"pass_rate", t.cases ? static_cast<double>(t.passed) / t.cases : 0.0},
+                       {"rays_per_s", t.timed ? std::exp(t.log_rays / t.timed) : 0.0},
+                       {"methods", methods},
+                       {"best_method", best.empty() ? json(nullptr) : json(best)}});
+  }
+  std::stable_sort(ranking.begin(), ranking.end(), [](const json& a, const json& b) {
+    const bool ca = a["passed"] == a["cases"], cb = b["passed"] == b["cases"];
+    if (ca != cb) return ca;
+    return a["rays_per_s"].get<double>() > b["rays_per_s"].get<double>();
+  });
+  for (size_t k = 0; k < ranking.size(); ++k) ranking[k]["rank"] = k + 1;
+  return ranking;
+}
+
+json recommend(const json& ranking, const json& sweep) {
+  json r = json::object();
+  const json* top = nullptr;
+  for (const json& b : ranking)
+    if (!b["best_method"].is_null()) {
+      top = &b;
+      break;
+    }
+  if (!top) {
+    r["backend"] = nullptr;
+    r["why"] = "no backend passed every conformance case of any method here";
+    return r;
+  }
+  r["backend"] = (*top)["backend"];
+  r["method"] = (*top)["best_method"];
+  r["rays_per_s"] = (*top)["methods"][(*top)["best_method"].get<std::string>()]["rays_per_s"];
+  r["why"] =
+      "the fastest backend of those that passed every conformance case, with its fastest "
+      "method of those that passed on every scene";
+  const MarchParams defaults;
+  json parameters = json::object();
+  // The surface types the sweep measured; `select` gives the defaults for the others.
+  for (const std::string& type : surface_types()) {
+    const json analysis = sweep.value("analysis", json::array());
+    if (std::none_of(analysis.begin(), analysis.end(),
+                     [&](const json& g) { return g["surface_type"] == type; }))
+      continue;
+    json choice = {{"eps", defaults.eps}, {"offset", defaults.offset}, {"source", "defaults"}};
+    for (const json& g : sweep.value("analysis", json::array()))
+      if (g["surface_type"] == type && g["method"] == r["method"] && g["precision"] == "f32" &&
+          !g["recommended"].is_null()) {
+        choice = {{"eps", g["recommended"]["eps"]},
+                  {"offset", g["recommended"]["offset"]},
+                  {"offset_label", g["recommended"]["offset_label"]},
+                  {"source", "sweep"}};
+      }
+    parameters[type] = choice;
+  }
+  r["parameters"] = parameters;
+  return r;
+}
+
+std::string describe_selection(const json& results, const std::string& type) {
+  const json& rec = results.at("recommendation");
+  std::string s = "measured " + results.value("created", std::string("?")) + " on " +
+                  describe_machine(results.at("fingerprint")) + "\n";
+  if (rec["backend"].is_null()) return s + "no choice: " + rec["why"].get<std::string>() + "\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "backend %s, method %s: %.3g Mrays/s (%s)\n",
+                rec["backend"].get<std::string>().c_str(), rec["method"].get<std::string>().c_str(),
+                rec["rays_per_s"].get<double>() / 1e6, rec["why"].get<std::string>().c_str());
+  s += line;
+  const auto line_for = [&](const std::string& t, const json& p, const std::string& note) {
+    return "  " + t + std::string(12 - std::min<size_t>(t.size(), 11), ' ') + "--backend " +
+           rec["backend"].get<std::string>() + " --method " + rec["method"].get<std::string>() +
+           " --eps " + number(p["eps"]) + " --offset " + number(p["offset"]) + note + "\n";
+  };
+  for (const auto& [t, p] : rec["parameters"].items())
+    if (type.empty() || t == type)
+      s += line_for(t, p,
+                    p["source"] == "sweep" ? "" : "   (defaults: the sweep found no stable point)");
+  if (!type.empty() && !rec["parameters"].contains(type)) {
+    const MarchParams defaults;
+    s += line_for(type, {{"eps", defaults.eps}, {"offset", defaults.offset}},
+                  "   (defaults: no scene of this type was swept)");
+  }
+  s += "ranking:\n";
+  for (const json& b : results.at("ranking")) {
+    std::snprintf(
+        line, sizeof line, "  %zu. %-7s %8.3g Mrays/s  %d/%d cases conform%s\n",
+        b["rank"].get<size_t>(), b["backend"].get<std::string>().c_str(),
+        b["rays_per_s"].get<double>() / 1e6, b["passed"].get<int>(), b["cases"].get<int>(),
+        b["errors"].get<int>() ? (", " + std::to_string(b["errors"].get<int>()) + " errors").c_str()
+                               : "");
+    s += line;
+  }
+  return s;
+}
+
+// --- The regression gate.
+
+namespace {
+
+// Figures of a case the gate holds, with their tolerance: worse is higher; a change beyond
+// abs + rel * baseline counts.
+struct Figure {
+  const char* name;
+  const char* source;  // "counters" or "accuracy"
+  double abs, rel;
+};
+constexpr Figure kFigures[] = {
+    {"steps_mean", "counters", 0.05, 0.02},     {"steps_p99", "counters", 1.0, 0.05},
+    {"crossings_mean", "counters", 0.01, 0.02}, {"out_of_steps", "counters", 0.001, 0.0},
+    {"hit_mismatch", "accuracy", 0.002, 0.0},   {"crossings_mismatch", "accuracy", 0.002, 0.0},
+    {"image_fail", "accuracy", 0.005, 0.0},     {"traces_diverged", "accuracy", 0.0, 0.0}};
+
+}  // namespace
+
+json make_baseline(const json& results) {
+  json tolerances = json::object();
+  for (const Figure& f : kFigures) tolerances[f.name] = {{"abs", f.abs}, {"rel", f.rel}};
+  json cases = json::object(), timings = json::object();
+  for (const json& c : results.at("matrix").at("cases")) {
+    if (c.contains("error")) continue;
+    json figures = json::object();
+    for (const Figure& f : kFigures)
+      if (c.contains(f.source) && c[f.source].contains(f.name))
+        figures[f.name] = c[f.source][f.name];
+    if (c.contains("accuracy")) figures["passed"] = c["accuracy"]["passed"];
+    cases[c["name"].get<std::string>()] = figures;
+    if (c.contains("time_samples_ms")) timings[c["name"].get<std::string>()] = c["time_samples_ms"];
+  }
+  return {{"format", "flatmarch-baseline/1"},
+          {"created", results.value("created", "")},
+          {"fingerprint", results.at("fingerprint")},
+          {"options", results.at("options")},
+          {"tolerances", tolerances},
+          {"cases", cases},
+          {"timings_ms", timings}};
+}
+
+double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b) {
+  const size_t n1 = a.size(), n2 = b.size(), n = n1 + n2;
+  if (n1 < 2 || n2 < 2) return 1.0;
+  std::vector<std::pair<double, int>> all;
+  for (double v : a) all.push_back({v, 0});
+  for (double v : b) all.push_back({v, 1});
+  std::sort(all.begin(), all.end());
+  double rank_sum_a = 0.0, ties = 0.0;
+  for (size_t i = 0; i < n;) {
+    size_t j = i;
+    while (j < n && all[j].first == all[i].first) ++j;
+    const double rank = 0.5 * static_cast<double>(i + 1 + j);  // mean of ranks i+1 .. j
+    for (size_t k = i; k < j; ++k)
+      if (all[k].second == 0) rank_sum_a += rank;
+    const double t = static_cast<double>(j - i);
+    ties += t * t * t - t;
+    i = j;
+  }
+  const double u1 = rank_sum_a - static_cast<double>(n1 * (n1 + 1)) / 2.0;
+  const double u = std::max(u1, static_cast<double>(n1 * n2) - u1);
+  const double mu = static_cast<double>(n1 * n2) / 2.0;
+  const double nn = static_cast<double>(n);
+  const double sigma =
+      std::sqrt(static_cast<double>(n1 * n2) / 12.0 * ((nn + 1.0) - ties / (nn * (nn - 1.0))));
+  if (sigma == 0.0) return 1.0;
+  const double z = (u - mu - 0.5) / sigma;
+  return std::min(1.0, std::erfc(z / std::sqrt(2.0)));
+}
+
+json check_baseline(const json& baseline, const json& results) {
+  json out = {{"regressions", json::array()},
+              {"improvements", json::array()},
+              {"missing", json::array()},
+              {"timing_warnings", json::array()},
+              {"compared", 0}};
+  std::map<std::string, const json*> now;
+  for (const json& c : results.at("matrix").at("cases")) now[c["name"].get<std::string>()] = &c;
+  const json& tolerances = baseline.at("tolerances");
+  int compared = 0;
+  for (const auto& [name, figures] : baseline.at("cases").items()) {
+    const auto it = now.find(name);
+    if (it == now.end()) {
+      out["missing"].push_back(name);
+      continue;
+    }
+    const json& c = *it->second;
+    if (c.contains("error")) {
+      out["regressions"].push_back(
+          {{"case", name}, {"figure", "error"}, {"now", c["error"]}, {"was", "ran"}});
+      continue;
+    }
+    ++compared;
+    if (figures.value("passed", false) && c.contains("accuracy") &&
+        !c["accuracy"]["passed"].get<bool>())
+      out["regressions"].push_back({{"case", name},
+                                    {"figure", "passed"},
+                                    {"was", true},
+                                    {"now", false},
+                                    {"failed_checks", c["accuracy"]["failed_checks"]}});
+    for (const Figure& f : kFigures) {
+      if (!figures.contains(f.name) || !c.contains(f.source) || !c[f.source].contains(f.name))
+        continue;
+      const double was = figures[f.name], is = c[f.source][f.name];
+      const json& tol = tolerances.at(f.name);
+      const double allowed = tol["abs"].get<double>() + tol["rel"].get<double>() * std::abs(was);
+      const json entry = {
+          {"case", name}, {"figure", f.name}, {"was", was}, {"now", is}, {"tolerance", allowed}};
+      if (is > was + allowed)
+        out["regressions"].push_back(entry);
+      else if (is < was - allowed)
+        out["improvements"].push_back(entry);
+    }
+    const json& samples = baseline.value("timings_ms", json::object());
+    if (samples.contains(name) && c.contains("time_samples_ms")) {
+      const std::vector<double> a = samples[name], b = c["time_samples_ms"];
+      std::vector<double> sa = a, sb = b;
+      std::sort(sa.begin(), sa.end());
+      std::sort(sb.begin(), sb.end());
+      const double ratio = sb[sb.size() / 2] / sa[sa.size() / 2];
+      const double p = mann_whitney_p(a, b);
+      if (p < 0.05 && ratio > 1.1)
+        out["timing_warnings"].push_back({{"case", name},
+                                          {"ratio", ratio},
+                                          {"p_value", p},
+                                          {"was_ms", sa[sa.size() / 2]},
+                                          {"now_ms", sb[sb.size() / 2]}});
+    }
+  }
+  out["compared"] = compared;
+  out["same_machine"] = baseline.at("fingerprint").value("cpu", json::object()) ==
+                        results.at("fingerprint").value("cpu", json::object());
+  return out;
+}
+
+}  // namespace flatmarch::reports

@@ -1,0 +1,65 @@
+// The report: the matrix, the sweep and the scaling series in one results file (with the
+// machine's fingerprint), the ranking of backends on this machine with recommended parameters,
+// and the regression gate against committed baselines of the deterministic figures.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "reports/matrix.hpp"
+#include "reports/scaling.hpp"
+#include "reports/sweep.hpp"
+
+namespace flatmarch::reports {
+
+struct ReportOptions {
+  MatrixOptions matrix;
+  SweepOptions sweep;
+  ScalingOptions scaling;
+  bool sweep_enabled = true, scaling_enabled = true;
+  // Scenes of the sweep: every scene when true, else the first scene of each surface type.
+  bool sweep_all_scenes = false;
+};
+
+using ReportProgress =
+    std::function<void(const std::string& stage, const std::string& line, int done, int total)>;
+
+// Runs what the options ask on the scenes and returns the results document: "format",
+// "created", "fingerprint", "options", "matrix", "sweep", "scaling", "ranking", "recommendation".
+nlohmann::json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
+                          const ReportProgress& progress);
+
+// The backends by the matrix: those whose every case passed the conformance suite first, each
+// group by the geometric mean of rays per second over its cases; per backend its pass rate,
+// speed, and fastest conforming method.
+nlohmann::json rank_backends(const nlohmann::json& matrix);
+
+// The choice for this machine: the top backend and its method, with eps and offset per surface
+// type from the sweep (DESIGN.md's defaults where the sweep has no stable point).
+nlohmann::json recommend(const nlohmann::json& ranking, const nlohmann::json& sweep);
+
+// `flatmarch select`'s text: the choice, and for `surface_type` (empty: every type) the flags.
+std::string describe_selection(const nlohmann::json& results, const std::string& surface_type);
+
+// --- The regression gate.
+
+// The deterministic figures of a results document per case (steps, crossings, conformance
+// rates), with the tolerances they are held to, and the timing samples (informative only).
+nlohmann::json make_baseline(const nlohmann::json& results);
+
+// Compares results with a baseline: "regressions" (a deterministic figure worse beyond its
+// tolerance, or a case that passed now failing), "improvements" (better beyond tolerance: the
+// baseline wants updating), "missing" (cases of the baseline not measured now), and
+// "timing_warnings" (slower, Mann-Whitney U test over the repetitions at alpha 0.05 and a
+// median ratio above 1.1).
+nlohmann::json check_baseline(const nlohmann::json& baseline, const nlohmann::json& results);
+
+// The two-sided p-value of the Mann-Whitney U test that samples a and b come from one
+// distribution (normal approximation with tie correction, as scipy's mannwhitneyu without
+// continuity correction); 1 when either has fewer than two samples.
+double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b);
+
+}  // namespace flatmarch::reports

@@ -1,0 +1,143 @@
+#include "reports/scaling.hpp"
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "reports/matrix.hpp"
+#include "reports/surfaces.hpp"
+
+namespace flatmarch::reports {
+
+using nlohmann::json;
+
+double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (size_t k = 0; k < x.size() && k < y.size(); ++k) {
+    if (!(x[k] > 0.0) || !(y[k] > 0.0)) continue;
+    const double lx = std::log(x[k]), ly = std::log(y[k]);
+    n += 1;
+    sx += lx;
+    sy += ly;
+    sxx += lx * lx;
+    sxy += lx * ly;
+  }
+  const double d = n * sxx - sx * sx;
+  return n >= 2 && d > 0.0 ? (n * sxy - sx * sy) / d : 0.0;
+}
+
+namespace {
+
+struct Point {
+  const Scene* scene;
+  int width, height;
+  double max_distance;
+  double x;
+};
+
+struct Series {
+  std::string axis, family;
+  std::vector<Point> points;
+};
+
+}  // namespace
+
+json run_scaling(const ScalingOptions& o,
+                 const std::function<void(const std::string&, int, int)>& progress) {
+  // Scenes live as long as the benchmarks that point at them.
+  std::vector<std::unique_ptr<Scene>> scenes;
+  const auto keep = [&](Scene s) {
+    scenes.push_back(std::make_unique<Scene>(std::move(s)));
+    return scenes.back().get();
+  };
+  std::vector<Series> series;
+  {
+    const Scene* scene = keep(o.resolution_scene ? *o.resolution_scene : empty_torus_prism());
+    Series s{"pixels", scene->name, {}};
+    for (const auto& [w, h] : o.resolutions)
+      s.points.push_back({scene, w, h, 20.0, static_cast<double>(w) * h});
+    series.push_back(s);
+  }
+  {
+    Series s{"edges", "regular 2n-gon", {}};
+    for (int n : o.polygon_n)
+      s.points.push_back(
+          {keep(regular_polygon_surface(n)), o.width, o.height, o.max_distance, 2.0 * n});
+    series.push_back(s);
+  }
+  {
+    Series s{"edges", "staircase of squares", {}};
+    for (int k : o.staircase_squares)
+      s.points.push_back({keep(staircase_surface(k)), o.width, o.height, o.max_distance, 4.0 * k});
+    series.push_back(s);
+  }
+  {
+    Series s{"max_distance", "empty torus prism", {}};
+    const Scene* prism = keep(empty_torus_prism());
+    for (double d : o.max_distances) s.points.push_back({prism, o.width, o.height, d, d});
+    series.push_back(s);
+  }
+
+  json out = {{"series", json::array()}, {"skipped", json::array()}};
+  std::vector<std::unique_ptr<Backend>> backends;
+  for (const std::string& name : o.backends) {
+    std::unique_ptr<Backend> b = make_backend(name, o.backend_options);
+    if (!b) throw std::invalid_argument("unknown backend \"" + name + "\"");
+    if (const Availability a = b->availability(); !a.available) {
+      out["skipped"].push_back({{"backend", name}, {"reason", "unavailable here: " + a.reason}});
+      continue;
+    }
+    backends.push_back(std::move(b));
+  }
+  const auto name_of = [](const Series& s, const Backend& b, Method m, const Point& p) {
+    return "scaling/" + s.axis + "/" + p.scene->name + "/" + b.name() + "/" + to_string(m) + "/" +
+           std::to_string(p.width) + "x" + std::to_string(p.height) + "/d" +
+           std::to_string(static_cast<int>(p.max_distance));
+  };
+  int total = 0;
+  for (const Series& s : series)
+    for (const auto& b : backends)
+      for (Method m : o.methods)
+        for (const Point& p : s.points) {
+          MarchParams params;
+          params.method = m;
+          params.max_distance = p.max_distance;
+          // Rays end by their path length, not by running out of steps.
+          params.max_steps = 1 << 16;
+          register_frame_benchmark(*b, *p.scene, p.scene->camera, params, p.width, p.height,
+                                   o.repetitions, o.min_time, nullptr, name_of(s, *b, m, p));
+          ++total;
+        }
+  int done = 0;
+  out["benchmarks"] = run_registered_benchmarks([&](const std::string& name) {
+    if (progress) progress("timed " + name, ++done, total);
+  });
+  const std::map<std::string, Timing> t = timings(out["benchmarks"]);
+  for (const Series& s : series)
+    for (const auto& b : backends)
+      for (Method m : o.methods) {
+        json j = {{"axis", s.axis},
+                  {"family", s.family},
+                  {"backend", b->name()},
+                  {"method", to_string(m)}};
+        std::vector<double> x, ms, steps, crossings;
+        for (const Point& p : s.points) {
+          const auto it = t.find(name_of(s, *b, m, p));
+          if (it == t.end() || !it->second.error.empty()) continue;
+          x.push_back(p.x);
+          ms.push_back(it->second.median_ms);
+          steps.push_back(it->second.counters.value("steps_mean", 0.0));
+          crossings.push_back(it->second.counters.value("crossings_mean", 0.0));
+        }
+        j["x"] = x;
+        j["time_ms"] = ms;
+        j["steps_mean"] = steps;
+        j["crossings_mean"] = crossings;
+        j["slope"] = loglog_slope(x, ms);
+        j["steps_slope"] = loglog_slope(x, steps);
+        out["series"].push_back(j);
+      }
+  return out;
+}
+
+}  // namespace flatmarch::reports

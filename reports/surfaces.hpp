@@ -1,0 +1,36 @@
+// Surface types, by which the report groups scenes and recommends parameters, and the generated
+// surfaces of the scaling measurements: regular 2n-gons and staircases of squares.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace flatmarch::reports {
+
+// The kinds of surface whose rays meet different hazards, in the order the report lists them:
+//   prism        a translation prism (z periodic): rays never escape, paths are long;
+//   mirror       a billiard table: mirror edges, rays reflect;
+//   dilation     similarity gluings: directions and lengths change at a crossing;
+//   reflection   non-orientable gluings (the Klein bottle);
+//   rotation     rotations or half-translations (unfolded polyhedra, the pillowcase): cone points;
+//   translation  translation surfaces only.
+// A scene of several kinds gets the first in this list.
+const std::vector<std::string>& surface_types();
+std::string surface_type(const Scene& scene);
+
+// The regular 2n-gon (n >= 2) with opposite edges glued by translations (the square torus for
+// n = 2, a genus-n/2 surface for even n), inradius 2, as a translation prism of period 2 with
+// no objects: every ray runs to max_distance, crossing about as many edges whatever n.
+Scene regular_polygon_surface(int n);
+
+// A staircase of `squares` (even, >= 2) squares of side 2, each its own room: right edges glue
+// square 2k to 2k+1, top edges 2k+1 to 2k+2 (cyclically), the rest follow (the classical
+// staircase square-tiled surface). Also a prism of period 2 with no objects.
+Scene staircase_surface(int squares);
+
+// The torus of side 4 as a translation prism with nothing in it: path length is max_distance.
+Scene empty_torus_prism();
+
+}  // namespace flatmarch::reports

@@ -1,0 +1,281 @@
+#include "reports/sweep.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include "reports/matrix.hpp"
+#include "reports/surfaces.hpp"
+
+namespace flatmarch::reports {
+
+using nlohmann::json;
+
+namespace {
+
+std::string number(double v) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%g", v);
+  return s;
+}
+
+const char* precision_name(Precision p) {
+  return p == Precision::f32 ? "f32" : "f64";
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// Whether a point's accuracy holds: every conformance check passes but Yee's perceptual metric,
+// which on the sweep's small frames turns on a few dozen pixels even at the defaults (1.26% of a
+// 64x36 frame of mirror_square against a limit of 1.2%); the per-pixel image check stays.
+bool stable_point(const json& accuracy) {
+  for (const json& name : accuracy["failed"])
+    if (name != "image.perceptual_failpercent") return false;
+  return true;
+}
+
+}  // namespace
+
+std::vector<std::string> offset_labels(const SweepOptions& o) {
+  std::vector<std::string> labels;
+  for (double f : o.offset_factors) labels.push_back(number(f) + "xeps");
+  for (double v : o.offset_fixed) labels.push_back(number(v));
+  return labels;
+}
+
+json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conformance::Suite& suite,
+               const SweepProgress& progress) {
+  const std::unique_ptr<Backend> backend = make_backend(o.backend, o.backend_options);
+  if (!backend) throw std::invalid_argument("unknown backend \"" + o.backend + "\"");
+  if (const Availability a = backend->availability(); !a.available)
+    throw std::invalid_argument("the " + o.backend + " backend is unavailable here: " + a.reason);
+  std::vector<Precision> precisions;
+  for (Precision p : o.precisions) {
+    const std::vector<Precision> has = backend->precisions();
+    if (std::find(has.begin(), has.end(), p) != has.end()) precisions.push_back(p);
+  }
+  // Every point is judged against one truth, masked as for the default parameters.
+  suite.fix_mask(MarchParams{});
+  const std::vector<std::string> labels = offset_labels(o);
+  const int total = static_cast<int>(scenes.size() * o.methods.size() * precisions.size() *
+                                     o.eps.size() * labels.size());
+  json points = json::array();
+  int done = 0;
+  for (const Scene& scene : scenes)
+    for (Method m : o.methods)
+      for (Precision p : precisions)
+        for (double eps : o.eps)
+          for (size_t k = 0; k < labels.size(); ++k) {
+            MarchParams params = o.params;
+            params.method = m;
+            params.precision = p;
+            params.eps = eps;
+            params.offset = k < o.offset_factors.size()
+                                ? o.offset_factors[k] * eps
+                                : o.offset_fixed[k - o.offset_factors.size()];
+            json point = {{"scene", scene.name},
+                          {"surface_type", surface_type(scene)},
+                          {"method", to_string(m)},
+                          {"precision", precision_name(p)},
+                          {"eps", eps},
+                          {"offset", params.offset},
+                          {"offset_label", labels[k]}};
+            try {
+              const conformance::CaseResult r =
+                  suite.run(*backend, scene, params, o.width, o.height);
+              std::vector<double> ms = {1e3 * r.seconds};
+              for (int rep = 1; rep < o.repetitions; ++rep) {
+                const auto start = std::chrono::steady_clock::now();
+                backend->render(scene, scene.camera, o.width, o.height, params, {});
+                ms.push_back(std::chrono::duration<double, std::milli>(
+                                 std::chrono::steady_clock::now() - start)
+                                 .count());
+              }
+              point["time_ms"] = median(ms);
+              point["steps_mean"] = r.steps.mean;
+              point["steps_p99"] = r.steps.p99;
+              point["accuracy"] = accuracy_summary(r);
+            } catch (const std::exception& e) {
+              point["error"] = e.what();
+            }
+            points.push_back(std::move(point));
+            if (progress)
+              progress(scene.name + " " + to_string(m) + " " + precision_name(p) +
+                           " eps=" + number(eps) + " offset=" + labels[k],
+                       ++done, total);
+          }
+  json options = {{"backend", o.backend},
+                  {"eps", o.eps},
+                  {"offset_labels", labels},
+                  {"size", std::to_string(o.width) + "x" + std::to_string(o.height)},
+                  {"repetitions", o.repetitions},
+                  {"max_steps", o.params.max_steps},
+                  {"max_distance", o.params.max_distance}};
+  return {{"options", options}, {"points", points}, {"analysis", analyse_sweep(points)}};
+}
+
+json analyse_sweep(const json& points) {
+  // Grid points by group (surface type, method, precision) and position (eps, offset label).
+  struct Cell {
+    double eps = 0.0, offset = 0.0;
+    std::string label;
+    int scenes = 0, passed = 0, errors = 0;
+    double time_ms = 0.0, steps_mean = 0.0, hit_mismatch = 0.0;
+    int traces = 0, diverged = 0;
+    long failures = 0;
+  };
+  struct Group {
+    std::vector<double> eps;
+    std::vector<std::string> labels;
+    std::map<std::pair<double, std::string>, Cell> cells;
+  };
+  std::map<std::string, Group> groups;
+  std::map<std::string, json> group_keys;
+  for (const json& p : points) {
+    const std::string key = p["surface_type"].get<std::string>() + "/" +
+                            p["method"].get<std::string>() + "/" +
+                            p["precision"].get<std::string>();
+    group_keys[key] = {{"surface_type", p["surface_type"]},
+                       {"method", p["method"]},
+                       {"precision", p["precision"]}};
+    Group& g = groups[key];
+    const double eps = p["eps"];
+    const std::string label = p["offset_label"];
+    if (std::find(g.eps.begin(), g.eps.end(), eps) == g.eps.end()) g.eps.push_back(eps);
+    if (std::find(g.labels.begin(), g.labels.end(), label) == g.labels.end())
+      g.labels.push_back(label);
+    Cell& c = g.cells[{eps, label}];
+    c.eps = eps;
+    c.offset = p["offset"];
+    c.label = label;
+    ++c.scenes;
+    if (p.contains("error")) {
+      ++c.errors;
+      continue;
+    }
+    const json& a = p["accuracy"];
+    c.passed += stable_point(a);
+    c.time_ms += p["time_ms"].get<double>();
+    c.steps_mean += p["steps_mean"].get<double>();
+    c.hit_mismatch += a["hit_mismatch"].get<double>();
+    c.traces += a["traces"].get<int>();
+    c.diverged += a["traces_diverged"].get<int>();
+    c.failures += a["failures_total"].get<long>();
+  }
+  json analysis = json::array();
+  for (auto& [key, g] : groups) {
+    json grid = json::array(), stable = json::array(), pareto = json::array();
+    std::vector<const Cell*> ran;
+    for (auto& [pos, c] : g.cells) {
+      const int n = c.scenes - c.errors;
+      if (n > 0) {
+        c.time_ms /= n;
+        c.steps_mean /= n;
+        c.hit_mismatch /= n;
+      }
+      const bool is_stable = c.errors == 0 && c.passed == c.scenes;
+      grid.push_back({{"eps", c.eps},
+                      {"offset", c.offset},
+                      {"offset_label", c.label},
+                      {"scenes", c.scenes},
+                      {"passed", c.passed},
+                      {"errors", c.errors},
+                      {"stable", is_stable},
+                      {"time_ms", c.time_ms},
+                      {"steps_mean", c.steps_mean},
+                      {"hit_mismatch", c.hit_mismatch},
+                      {"traces", c.traces},
+                      {"traces_diverged", c.diverged},
+                      {"failures", c.failures}});
+      if (is_stable) stable.push_back({{"eps", c.eps}, {"offset_label", c.label}});
+      if (c.errors == 0) ran.push_back(&c);
+    }
+    // Pareto front: by time, each point more accurate than every faster one.
+    std::sort(ran.begin(), ran.end(),
+              [](const Cell* a, const Cell* b) { return a->time_ms < b->time_ms; });
+    double best = 2.0;
+    for (const Cell* c : ran)
+      if (c->hit_mismatch < best) {
+        best = c->hit_mismatch;
+        pareto.push_back({{"eps", c->eps},
+                          {"offset", c->offset},
+                          {"offset_label", c->label},
+                          {"time_ms", c->time_ms},
+                          {"hit_mismatch", c->hit_mismatch}});
+      }
+    // Recommended: of the stable points whose eps neighbours (a decade either side, same offset
+    // rule) are stable too, so that neither rounding nor a neighbouring choice tips them (failing
+    // that, of all stable points), those within 10% of the fastest — closer than this machine's
+    // timing noise — and of these the one with the most stable neighbours on the grid, then the
+    // one nearest the defaults.
+    std::sort(g.eps.begin(), g.eps.end());
+    const auto stable_at = [&](long e, long k) {
+      if (e < 0 || k < 0 || e >= static_cast<long>(g.eps.size()) ||
+          k >= static_cast<long>(g.labels.size()))
+        return false;
+      const auto it =
+          g.cells.find({g.eps[static_cast<size_t>(e)], g.labels[static_cast<size_t>(k)]});
+      return it != g.cells.end() && it->second.errors == 0 &&
+             it->second.passed == it->second.scenes;
+    };
+    struct Candidate {
+      const Cell* cell;
+      bool interior;
+      int margin;           // stable neighbours of the 8 around it
+      double from_default;  // |log10(eps / 1e-4)|
+    };
+    std::vector<Candidate> candidates;
+    for (long e = 0; e < static_cast<long>(g.eps.size()); ++e)
+      for (long k = 0; k < static_cast<long>(g.labels.size()); ++k) {
+        if (!stable_at(e, k)) continue;
+        int margin = 0;
+        for (long de = -1; de <= 1; ++de)
+          for (long dk = -1; dk <= 1; ++dk) margin += (de || dk) && stable_at(e + de, k + dk);
+        const Cell* c =
+            &g.cells.at({g.eps[static_cast<size_t>(e)], g.labels[static_cast<size_t>(k)]});
+        candidates.push_back({c, stable_at(e - 1, k) && stable_at(e + 1, k), margin,
+                              std::abs(std::log10(c->eps / MarchParams{}.eps))});
+      }
+    const bool any_interior = std::any_of(candidates.begin(), candidates.end(),
+                                          [](const Candidate& c) { return c.interior; });
+    std::erase_if(candidates, [&](const Candidate& c) { return any_interior && !c.interior; });
+    double fastest = std::numeric_limits<double>::infinity();
+    for (const Candidate& c : candidates) fastest = std::min(fastest, c.cell->time_ms);
+    std::erase_if(candidates, [&](const Candidate& c) { return c.cell->time_ms > 1.1 * fastest; });
+    const auto chosen = std::min_element(candidates.begin(), candidates.end(),
+                                         [](const Candidate& a, const Candidate& b) {
+                                           if (a.margin != b.margin) return a.margin > b.margin;
+                                           return a.from_default < b.from_default;
+                                         });
+    const Cell* pick = chosen == candidates.end() ? nullptr : chosen->cell;
+    const bool interior = any_interior;
+    json group = group_keys[key];
+    group["grid"] = grid;
+    group["stable"] = stable;
+    group["pareto"] = pareto;
+    group["recommended"] =
+        pick ? json{{"eps", pick->eps},
+                    {"offset", pick->offset},
+                    {"offset_label", pick->label},
+                    {"time_ms", pick->time_ms},
+                    {"hit_mismatch", pick->hit_mismatch},
+                    {"why", std::string(interior ? "of the stable points whose neighbours a "
+                                                   "decade of eps either side are stable too"
+                                                 : "of the stable points (none has stable "
+                                                   "neighbours a decade of eps either side)") +
+                                ", within 10% of the fastest, the one with the most stable "
+                                "neighbours on the grid"}}
+             : json(nullptr);
+    analysis.push_back(group);
+  }
+  return analysis;
+}
+
+}  // namespace flatmarch::reports

@@ -1,0 +1,350 @@
+// The report's parts: surface types and generated surfaces, the statistics, the sweep's analysis,
+// the ranking, the regression gate, and the commands end to end on small inputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "reports/report.hpp"
+#include "reports/surfaces.hpp"
+#include "scene/load.hpp"
+#include "tests/process.hpp"
+
+namespace flatmarch::reports {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+Scene gallery(const std::string& name) {
+  return load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "scenes" / (name + ".json"));
+}
+
+TEST(SurfaceType, ClassifiesTheGalleryByItsHazards) {
+  EXPECT_EQ(surface_type(gallery("torus")), "translation");
+  EXPECT_EQ(surface_type(gallery("double_pentagon")), "translation");
+  EXPECT_EQ(surface_type(gallery("cube")), "rotation");
+  EXPECT_EQ(surface_type(gallery("pillowcase")), "rotation");
+  EXPECT_EQ(surface_type(gallery("klein_bottle")), "reflection");
+  EXPECT_EQ(surface_type(gallery("mirror_square")), "mirror");
+  EXPECT_EQ(surface_type(gallery("torus_prism")), "prism");
+  EXPECT_EQ(surface_type(load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "conformance" / "scenes" /
+                                    "dilation.json")),
+            "dilation");
+}
+
+TEST(GeneratedSurfaces, RegularPolygonHasTheGenusOfItsEdgeCount) {
+  // A regular 2n-gon's corners sum to 2pi(n - 1): one cone point for even n (genus n/2), two
+  // for odd n (genus (n-1)/2).
+  for (int n : {2, 3, 4, 5, 8, 32}) {
+    const Scene s = regular_polygon_surface(n);
+    ASSERT_EQ(s.polygons.size(), 1u);
+    EXPECT_EQ(s.polygons[0].edges.size(), static_cast<size_t>(2 * n));
+    for (const Gluing& g : s.gluings) EXPECT_EQ(g.type, GluingType::translation);
+    EXPECT_EQ(s.topology.genus, n / 2) << n;
+    double angles = 0.0;
+    for (const VertexClass& v : s.vertex_classes) angles += v.cone_angle;
+    EXPECT_NEAR(angles, 2.0 * M_PI * (n - 1), 1e-9) << n;
+    EXPECT_TRUE(s.period.has_value());
+    EXPECT_TRUE(s.objects.empty());
+  }
+  EXPECT_THROW(regular_polygon_surface(1), std::invalid_argument);
+}
+
+TEST(GeneratedSurfaces, StaircaseIsSquareTiled) {
+  // Two squares: the 2x1 torus (genus 1). Any staircase: k rooms, 4k corners of pi/2 each.
+  EXPECT_EQ(staircase_surface(2).topology.genus, 1);
+  for (int k : {2, 4, 16}) {
+    const Scene s = staircase_surface(k);
+    EXPECT_EQ(s.polygons.size(), static_cast<size_t>(k));
+    EXPECT_EQ(s.gluings.size(), static_cast<size_t>(2 * k));
+    double angles = 0.0;
+    for (const VertexClass& v : s.vertex_classes) {
+      angles += v.cone_angle;
+      EXPECT_NEAR(std::fmod(v.cone_angle + 1e-9, 2.0 * M_PI), 0.0, 1e-6);  // multiples of 2pi
+    }
+    EXPECT_NEAR(angles, 2.0 * M_PI * k, 1e-9);
+    EXPECT_EQ(surface_type(s), "prism");
+  }
+  EXPECT_THROW(staircase_surface(3), std::invalid_argument);
+}
+
+TEST(Statistics, LogLogSlopeOfAPowerLaw) {
+  EXPECT_NEAR(loglog_slope({1, 2, 4, 8}, {3, 3 * std::pow(2, 1.5), 3 * 8, 3 * std::pow(8, 1.5)}),
+              1.5, 1e-12);
+  EXPECT_NEAR(loglog_slope({10, 100}, {5, 5}), 0.0, 1e-12);
+  EXPECT_EQ(loglog_slope({1}, {1}), 0.0);  // one point has no slope
+}
+
+TEST(Statistics, MannWhitneyAsScipyComputesIt) {
+  // scipy.stats.mannwhitneyu([1,2,3], [4,5,6], method="asymptotic"): U = 9, mu = 4.5,
+  // sigma = sqrt(9 * 7 / 12), z = (9 - 4.5 - 0.5) / sigma, p = erfc(z / sqrt 2) = 0.0809.
+  EXPECT_NEAR(mann_whitney_p({1, 2, 3}, {4, 5, 6}), 0.080856, 1e-5);
+  EXPECT_NEAR(mann_whitney_p({4, 5, 6}, {1, 2, 3}), 0.080856, 1e-5);
+  // Nine against nine, apart: significant; interleaved: not.
+  EXPECT_LT(mann_whitney_p({1, 2, 3, 4, 5, 6, 7, 8, 9}, {11, 12, 13, 14, 15, 16, 17, 18, 19}),
+            0.001);
+  EXPECT_GT(mann_whitney_p({1, 3, 5, 7, 9}, {2, 4, 6, 8, 10}), 0.5);
+  EXPECT_EQ(mann_whitney_p({1, 1, 1}, {1, 1, 1}), 1.0);  // all tied
+  EXPECT_EQ(mann_whitney_p({1}, {2, 3}), 1.0);
+}
+
+// A sweep point as run_sweep writes it.
+json point(const std::string& scene, double eps, const std::string& label, bool passed,
+           double time_ms, double mismatch) {
+  return {{"scene", scene},
+          {"surface_type", "translation"},
+          {"method", "sphere"},
+          {"precision", "f32"},
+          {"eps", eps},
+          {"offset", 2 * eps},
+          {"offset_label", label},
+          {"time_ms", time_ms},
+          {"steps_mean", 10.0 / eps},
+          {"steps_p99", 20.0},
+          {"accuracy",
+           {{"passed", passed},
+            {"failed", passed ? json::array() : json::array({"hit_rate"})},
+            {"hit_mismatch", mismatch},
+            {"traces", 8},
+            {"traces_diverged", passed ? 0 : 1},
+            {"failures_total", passed ? 0 : 5}}}};
+}
+
+TEST(SweepAnalysis, RecommendsTheFastestPointWithStableNeighbours) {
+  // eps 1e-1 fails everywhere; 1e-2 is stable for one scene only; 1e-3 ... 1e-5 are stable.
+  // Time grows as eps shrinks. The fastest stable point, 1e-3, has an unstable neighbour
+  // (1e-2); 1e-4 is the fastest with both neighbours stable.
+  json points = json::array();
+  const double eps[] = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5};
+  for (const std::string scene : {"a", "b"})
+    for (int e = 0; e < 5; ++e) {
+      const bool passed = e >= 2 || (e == 1 && scene == "a");
+      points.push_back(
+          point(scene, eps[e], "2xeps", passed, 1.0 + e, passed ? 0.001 * (5 - e) : 0.3));
+    }
+  const json analysis = analyse_sweep(points);
+  ASSERT_EQ(analysis.size(), 1u);
+  const json& g = analysis[0];
+  EXPECT_EQ(g["stable"].size(), 3u);
+  EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-4);
+  // Pareto front by time: 1e-1 (0.3), 1e-2 (mean 0.152), 1e-3, 1e-4, 1e-5, each more accurate.
+  ASSERT_EQ(g["pareto"].size(), 5u);
+  EXPECT_EQ(g["pareto"][0]["eps"].get<double>(), 1e-1);
+  for (const json& cell : g["grid"])
+    if (cell["eps"] == 1e-2) {
+      EXPECT_EQ(cell["passed"], 1);
+    }
+}
+
+TEST(SweepAnalysis, NothingStableRecommendsNothing) {
+  const json analysis = analyse_sweep(json::array(
+      {point("a", 1e-1, "2xeps", false, 1.0, 0.5), point("a", 1e-2, "2xeps", false, 2.0, 0.2)}));
+  EXPECT_TRUE(analysis[0]["recommended"].is_null());
+  EXPECT_TRUE(analysis[0]["stable"].empty());
+}
+
+json matrix_case(const std::string& backend, const std::string& method, const std::string& scene,
+                 double rays, bool passed, double steps) {
+  return {{"name", backend + "/" + method + "/" + scene + "/32x18"},
+          {"backend", backend},
+          {"method", method},
+          {"scene", scene},
+          {"surface_type", "translation"},
+          {"time_ms", 1e3 / rays},
+          {"time_samples_ms", {1e3 / rays, 1e3 / rays, 1.01e3 / rays}},
+          {"counters", {{"rays_per_s", rays}, {"steps_mean", steps}, {"steps_p99", 2 * steps}}},
+          {"accuracy",
+           {{"passed", passed},
+            {"hit_mismatch", passed ? 0.0 : 0.01},
+            {"failed_checks", passed ? json::array() : json::array({"hit_rate 0.99 < 0.999"})}}}};
+}
+
+TEST(Ranking, ConformingBackendsFirstThenBySpeed) {
+  // fast: twice as fast as slow but fails one case of sphere; slow conforms everywhere.
+  json cases = json::array();
+  for (const std::string scene : {"x", "y"}) {
+    cases.push_back(matrix_case("slow", "sphere", scene, 1e6, true, 10));
+    cases.push_back(matrix_case("slow", "analytic", scene, 4e6, true, 3));
+    cases.push_back(matrix_case("fast", "sphere", scene, 2e6, scene == "x", 10));
+    cases.push_back(matrix_case("fast", "analytic", scene, 8e6, true, 3));
+  }
+  const json ranking = rank_backends({{"cases", cases}});
+  ASSERT_EQ(ranking.size(), 2u);
+  EXPECT_EQ(ranking[0]["backend"], "slow");
+  EXPECT_EQ(ranking[0]["rank"], 1);
+  EXPECT_NEAR(ranking[0]["rays_per_s"].get<double>(), 2e6, 1.0);  // geometric mean of 1e6, 4e6
+  EXPECT_EQ(ranking[0]["best_method"], "analytic");
+  EXPECT_EQ(ranking[1]["passed"], 3);
+  // fast's analytic conforms: it is its best method even though the backend does not.
+  EXPECT_EQ(ranking[1]["best_method"], "analytic");
+  const json rec = recommend(ranking, json::object());
+  EXPECT_EQ(rec["backend"], "slow");
+  EXPECT_EQ(rec["method"], "analytic");
+  EXPECT_TRUE(rec["parameters"].empty());  // no sweep: select falls back to the defaults
+}
+
+TEST(Gate, DeterministicFiguresAreHeldToTheirTolerance) {
+  const json fingerprint = {{"cpu", {{"model", "test"}}}};
+  json before = {
+      {"fingerprint", fingerprint},
+      {"options", json::object()},
+      {"matrix",
+       {{"cases", json::array({matrix_case("scalar", "sphere", "x", 1e6, true, 100),
+                               matrix_case("scalar", "sphere", "y", 1e6, true, 100),
+                               matrix_case("scalar", "sphere", "z", 1e6, true, 100),
+                               matrix_case("scalar", "sphere", "w", 1e6, true, 100)})}}}};
+  const json baseline = make_baseline(before);
+  EXPECT_EQ(baseline["cases"].size(), 4u);
+  // steps_mean's tolerance: 0.05 + 2% of 100 = 2.05 steps; steps_p99's: 1 + 5% of 200 = 11.
+  json after = before;
+  after["matrix"]["cases"] = json::array({
+      matrix_case("scalar", "sphere", "x", 1e6, true, 102),    // within tolerance
+      matrix_case("scalar", "sphere", "y", 1e6, true, 102.1),  // beyond: regression
+      matrix_case("scalar", "sphere", "z", 1e6, false, 90),    // fails now; fewer steps
+  });
+  const json check = check_baseline(baseline, after);
+  EXPECT_EQ(check["compared"], 3);
+  ASSERT_EQ(check["missing"].size(), 1u);
+  EXPECT_EQ(check["missing"][0], "scalar/sphere/w/32x18");
+  std::set<std::string> regressed;
+  for (const json& r : check["regressions"])
+    regressed.insert(r["case"].get<std::string>() + ":" + r["figure"].get<std::string>());
+  const std::set<std::string> want = {"scalar/sphere/y/32x18:steps_mean",
+                                      "scalar/sphere/z/32x18:passed",
+                                      "scalar/sphere/z/32x18:hit_mismatch"};
+  EXPECT_EQ(regressed, want);
+  std::set<std::string> improved;
+  for (const json& r : check["improvements"]) improved.insert(r["figure"].get<std::string>());
+  EXPECT_EQ(improved, (std::set<std::string>{"steps_mean", "steps_p99"}));
+  EXPECT_TRUE(check["same_machine"].get<bool>());
+  EXPECT_TRUE(check["timing_warnings"].empty());  // three repetitions cannot be significant
+}
+
+TEST(Gate, SlowerTimingsWarnOnlyWhenSignificant) {
+  json before = {
+      {"fingerprint", {{"cpu", {{"model", "a"}}}}},
+      {"options", json::object()},
+      {"matrix", {{"cases", json::array({matrix_case("s", "sphere", "x", 1e6, true, 9)})}}}};
+  before["matrix"]["cases"][0]["time_samples_ms"] = {1.0, 1.01, 0.99, 1.02, 0.98, 1.0, 1.01};
+  json after = before;
+  after["fingerprint"]["cpu"]["model"] = "b";
+  after["matrix"]["cases"][0]["time_samples_ms"] = {1.5, 1.52, 1.49, 1.51, 1.5, 1.48, 1.53};
+  const json check = check_baseline(make_baseline(before), after);
+  ASSERT_EQ(check["timing_warnings"].size(), 1u);
+  EXPECT_NEAR(check["timing_warnings"][0]["ratio"].get<double>(), 1.5, 0.02);
+  EXPECT_TRUE(check["regressions"].empty());  // timings never fail the gate
+  EXPECT_FALSE(check["same_machine"].get<bool>());
+}
+
+// The commands end to end, on the torus and the scalar backend at a small size.
+TEST(ReportCommand, MeasuresSelectsAndGates) {
+  const std::string dir = test::make_temp_dir();
+  const std::string torus = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
+  const auto r = test::run_flatmarch({"report",
+                                      "--scene",
+                                      torus,
+                                      "--backend",
+                                      "scalar",
+                                      "--method",
+                                      "analytic",
+                                      "--size",
+                                      "48x27",
+                                      "--conform-size",
+                                      "48x27",
+                                      "--min-time",
+                                      "0.001",
+                                      "--no-sweep",
+                                      "--no-scaling",
+                                      "--no-html",
+                                      "-q",
+                                      "-o",
+                                      dir,
+                                      "--write-baseline",
+                                      dir + "/baseline.json"},
+                                     300);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(dir + "/results.json");
+  const json results = json::parse(in);
+  EXPECT_TRUE(results["fingerprint"]["cpu"].contains("model"));
+  EXPECT_TRUE(results["matrix"]["benchmarks"]["context"].contains("fingerprint/cpu/model"));
+  ASSERT_EQ(results["matrix"]["cases"].size(), 1u);
+  const json& c = results["matrix"]["cases"][0];
+  EXPECT_EQ(c["name"], "scalar/analytic/torus/48x27");
+  EXPECT_GT(c["time_ms"].get<double>(), 0.0);
+  EXPECT_EQ(c["time_samples_ms"].size(), 3u);
+  EXPECT_TRUE(c["accuracy"]["passed"].get<bool>());
+  EXPECT_GT(c["counters"]["steps_mean"].get<double>(), 1.0);
+  EXPECT_EQ(results["recommendation"]["backend"], "scalar");
+
+  const auto s = test::run_flatmarch({"select", dir + "/results.json", "--scene", torus});
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  EXPECT_NE(s.out.find("translation --backend scalar --method analytic --eps 0.0001"),
+            std::string::npos)
+      << s.out;
+
+  // The same measurement against its own baseline passes the gate.
+  const auto g = test::run_flatmarch({"report",         "--scene",    torus,
+                                      "--backend",      "scalar",     "--method",
+                                      "analytic",       "--size",     "48x27",
+                                      "--conform-size", "48x27",      "--min-time",
+                                      "0.001",          "--no-sweep", "--no-scaling",
+                                      "--no-html",      "-q",         "-o",
+                                      dir + "/again",   "--baseline", dir + "/baseline.json"},
+                                     300);
+  EXPECT_EQ(g.exit_code, 0) << g.out << g.err;
+  EXPECT_NE(g.out.find("gate: 1 cases compared"), std::string::npos) << g.out;
+  EXPECT_NE(g.out.find("0 regressions"), std::string::npos) << g.out;
+
+  const auto bad = test::run_flatmarch({"select", dir + "/nothing.json"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("run `flatmarch report` first"), std::string::npos);
+}
+
+TEST(SweepCommand, FindsTheDefaultsStableAndAHugeEpsNot) {
+  const std::string dir = test::make_temp_dir();
+  const auto r = test::run_flatmarch({"sweep",
+                                      "--scene",
+                                      std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json",
+                                      "--method",
+                                      "sphere",
+                                      "--precision",
+                                      "f32",
+                                      "--eps",
+                                      "0.1",
+                                      "--eps",
+                                      "0.0001",
+                                      "--offset-factor",
+                                      "2",
+                                      "--offset-factor",
+                                      "10",
+                                      "--offset-fixed",
+                                      "0.01",
+                                      "--size",
+                                      "48x27",
+                                      "-q",
+                                      "--json",
+                                      dir + "/sweep.json"},
+                                     300);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(dir + "/sweep.json");
+  const json sweep = json::parse(in);
+  ASSERT_EQ(sweep["points"].size(), 6u);
+  for (const json& p : sweep["points"]) {
+    const bool defaults = p["eps"] == 1e-4 && p["offset_label"] == "2xeps";
+    // eps = 0.1 with offset 1.0 skips a quarter of the room at every gluing.
+    if (p["eps"] == 0.1 && p["offset_label"] == "10xeps") {
+      EXPECT_GT(p["accuracy"]["hit_mismatch"].get<double>(), 0.01);
+    }
+    if (defaults) {
+      EXPECT_TRUE(p["accuracy"]["passed"].get<bool>()) << p.dump();
+    }
+  }
+  const json& g = sweep["analysis"][0];
+  EXPECT_EQ(g["surface_type"], "translation");
+  EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-4) << g.dump();
+}
+
+}  // namespace
+}  // namespace flatmarch::reports
