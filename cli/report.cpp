@@ -106,7 +106,7 @@ void add_report(CLI::App& app) {
     std::string out = "reports/out", size, conform_size = "160x90", sweep_size, sweep_backend;
     std::string baseline, write_baseline, python = default_python();
     int repetitions = 0;
-    double min_time = 0.05;
+    double min_time = 0.02;
     bool full = false, no_sweep = false, no_scaling = false, no_html = false, quiet = false;
     MarchParams params;
     BackendOptions backend_options;
@@ -125,7 +125,7 @@ void add_report(CLI::App& app) {
   cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
   cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
   cmd->add_option("--method", o->methods, "sphere, relaxed or analytic (repeat; default: all)");
-  cmd->add_option("--size", o->size, "Timed frames WxH (default 320x180; --full 640x360)");
+  cmd->add_option("--size", o->size, "Timed frames WxH (default 256x144; --full 640x360)");
   cmd->add_option("--conform-size", o->conform_size, "Frames measured against the oracle")
       ->capture_default_str();
   cmd->add_option("--repetitions", o->repetitions,
@@ -180,7 +180,7 @@ void add_report(CLI::App& app) {
         throw UsageError("--backend: unknown backend \"" + b + "\" (see `flatmarch backends`)");
     }
     std::tie(r.matrix.width, r.matrix.height) =
-        parse_size("--size", o->size.empty() ? (o->full ? "640x360" : "320x180") : o->size);
+        parse_size("--size", o->size.empty() ? (o->full ? "640x360" : "256x144") : o->size);
     std::tie(r.matrix.conform_width, r.matrix.conform_height) =
         parse_size("--conform-size", o->conform_size);
     r.matrix.repetitions = o->repetitions ? o->repetitions : (o->full ? 5 : 3);
@@ -199,6 +199,7 @@ void add_report(CLI::App& app) {
     r.sweep.params.max_steps = o->params.max_steps;
     r.sweep.backend_options = o->backend_options;
     if (!o->sweep_backend.empty()) r.sweep.backend = o->sweep_backend;
+    r.sweep.repetitions = o->full ? 3 : 2;
     std::tie(r.sweep.width, r.sweep.height) = parse_size(
         "--sweep-size", o->sweep_size.empty() ? (o->full ? "96x54" : "64x36") : o->sweep_size);
 

@@ -21,6 +21,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.colors import LogNorm  # noqa: E402
+from matplotlib.patheffects import withStroke  # noqa: E402
 
 BACKEND_COLOURS = {"scalar": "#1f77b4", "simd": "#2ca02c", "opengl": "#d62728", "vulkan": "#9467bd"}
 METHOD_MARKERS = {"sphere": "o", "relaxed": "s", "analytic": "^"}
@@ -247,7 +248,8 @@ def sweep_section(sweep):
            "against one truth (the oracle, masked as for the default parameters). <b>Stability</b> heatmaps: the "
            "colour is the share of decided pixels whose hit is wrong (mean over the surface type's scenes, log); "
            "a tick marks a stable point (every scene passes the conformance checks but the perceptual one, "
-           "which small frames make noisy); the star, the recommendation: the fastest stable point whose "
+           "which small frames make noisy; a tick on a dark cell is an error the thresholds allow, such as the "
+           "translation prisms' rays running out of steps under sphere tracing); the star, the recommendation: the fastest stable point whose "
            "neighbours a decade of eps either side are stable too. <b>Steps</b> heatmaps: mean kernel steps per "
            "ray. The Pareto chart: each grid point's time against its error; the front joins the points no other "
            "beats on both.</p>"]
@@ -286,8 +288,8 @@ def sweep_section(sweep):
                         for k, lab in enumerate(labels):
                             c = cells.get((e, lab))
                             if c and what == "stability" and c["stable"]:
-                                ax.text(k, r, "\u2713", ha="center", va="center", color="#1a9850", fontsize=10,
-                                        fontweight="bold")
+                                ax.text(k, r, "\u2713", ha="center", va="center", color="#33ff77", fontsize=11,
+                                        fontweight="bold", path_effects=[withStroke(linewidth=2, foreground="black")])
                             if c and what == "steps" and not math.isnan(grid[r][k]):
                                 ax.text(k, r, f"{grid[r][k]:.0f}", ha="center", va="center", fontsize=6,
                                         color="white" if grid[r][k] < 40 else "black")

@@ -20,10 +20,10 @@ struct MatrixOptions {
   BackendOptions backend_options;
   std::vector<Method> methods = {Method::sphere, Method::relaxed, Method::analytic};
   MarchParams params;             // eps, offset, ...; the method is each case's
-  int width = 320, height = 180;  // timed frames
+  int width = 256, height = 144;  // timed frames
   int conform_width = 160, conform_height = 90;
   int repetitions = 3;      // Google Benchmark repetitions of each timed case
-  double min_time = 0.05;   // seconds per repetition, at least one frame
+  double min_time = 0.02;   // seconds per repetition, at least one frame
   bool conformance = true;  // measure against the oracle too
   bool timing = true;
   // Where to write each backend's frame of each scene (sphere method) as BACKEND/SCENE.png; empty:

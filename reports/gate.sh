@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The regression gate: measures the deterministic figures (steps, crossings, conformance rates of
+# every backend x method x gallery scene; timings too, which only warn) and checks them against
+# reports/baseline.json. `reports/gate.sh --write` measures the same way and writes the baseline
+# instead: do it on purpose, in a commit that says why the figures changed.
+#   reports/gate.sh [--write] [FLATMARCH [OUT]]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+write=0
+if [[ ${1:-} == --write ]]; then
+  write=1
+  shift
+fi
+flatmarch=${1:-$root/build/cli/flatmarch}
+out=${2:-$root/build/gate}
+cd "$root"
+options=(report --no-sweep --no-scaling --no-html -q --size 160x90 --conform-size 160x90
+         --repetitions 5 --min-time 0.01 -o "$out")
+if ((write)); then
+  "$flatmarch" "${options[@]}" --write-baseline reports/baseline.json
+else
+  "$flatmarch" "${options[@]}" --baseline reports/baseline.json
+fi
