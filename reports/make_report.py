@@ -199,9 +199,18 @@ def steps_heatmap_section(cases):
     ax.set_xticks(range(len(columns)), [f"{b}\n{m}" for b, m in columns], fontsize=7, rotation=90)
     fig.colorbar(im, ax=ax, label="mean steps per ray (log)")
     ax.set_title("Kernel steps per ray")
+    lanes = {(c["scene"], c["method"]): c["counters"]["lane_utilisation"] for c in cases
+             if "lane_utilisation" in c.get("counters", {})}
+    lane_table = ""
+    if lanes:
+        methods = [m for m in ["sphere", "relaxed", "analytic"] if any(k[1] == m for k in lanes)]
+        lane_table = ("<p>SIMD lane utilisation: the share of packet lanes doing work, over every step of every "
+                      "packet (rays of a packet that finish early, or step apart, leave lanes idle).</p>" +
+                      table(["scene"] + methods,
+                            [[s] + [pct(lanes[(s, m)]) if (s, m) in lanes else "-" for m in methods] for s in scenes]))
     return ("<h2 id=steps>Steps per ray</h2><p>The mean number of kernel iterations per ray of the timed frames, per "
             "scene, backend and method: the cost the backends share; backends of one method should agree.</p>"
-            + figure_html(fig, "steps heatmap"))
+            + figure_html(fig, "steps heatmap") + lane_table)
 
 
 def failure_section(cases):

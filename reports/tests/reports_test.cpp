@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "reports/report.hpp"
 #include "reports/surfaces.hpp"
@@ -296,6 +297,22 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_EQ(g.exit_code, 0) << g.out << g.err;
   EXPECT_NE(g.out.find("gate: 1 cases compared"), std::string::npos) << g.out;
   EXPECT_NE(g.out.find("0 regressions"), std::string::npos) << g.out;
+
+  // The page of one run, and the page comparing two (both runs here, for the test).
+  const auto page = test::run_flatmarch({"report", dir + "/results.json", "-o", dir + "/page"});
+  ASSERT_EQ(page.exit_code, 0) << page.err;
+  std::ifstream html(dir + "/page/index.html");
+  const std::string text((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("Use <b>scalar</b> with the <b>analytic</b> method"), std::string::npos);
+  EXPECT_NE(text.find("data:image/png;base64,"), std::string::npos);  // charts embedded
+  const auto compare = test::run_flatmarch(
+      {"report", dir + "/results.json", dir + "/again/results.json", "-o", dir + "/compare"});
+  ASSERT_EQ(compare.exit_code, 0) << compare.err;
+  std::ifstream html2(dir + "/compare/index.html");
+  const std::string text2((std::istreambuf_iterator<char>(html2)),
+                          std::istreambuf_iterator<char>());
+  EXPECT_NE(text2.find("machines compared"), std::string::npos);
+  EXPECT_NE(text2.find("<td>scalar</td><td>1</td>"), std::string::npos);  // one common case
 
   const auto bad = test::run_flatmarch({"select", dir + "/nothing.json"});
   EXPECT_EQ(bad.exit_code, 2);
