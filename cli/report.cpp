@@ -1,5 +1,6 @@
 // `flatmarch report`, `flatmarch select` and `flatmarch sweep`: the suite's answers for its
 // users — which backend is fastest here, which parameters are safe, and did anything get worse.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -48,12 +49,20 @@ std::vector<Method> parse_methods(const std::vector<std::string>& names) {
   return methods;
 }
 
+// A word for the shell, quoted.
+std::string quoted(const std::string& word) {
+  std::string q = "'";
+  for (char c : word) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
 // Charts and the page, by reports/make_report.py with matplotlib.
 void make_html(const std::string& python, const std::vector<std::string>& results,
                const fs::path& out) {
-  std::string command = "'" + python + "' '" FLATMARCH_SOURCE_DIR "/reports/make_report.py' -o '" +
-                        out.string() + "'";
-  for (const std::string& r : results) command += " '" + r + "'";
+  std::string command = quoted(python) + " " +
+                        quoted(FLATMARCH_SOURCE_DIR "/reports/make_report.py") + " -o " +
+                        quoted(out.string());
+  for (const std::string& r : results) command += " " + quoted(r);
   if (std::system(command.c_str()) != 0)
     throw std::runtime_error(
         "the charts and the page could not be made (" + command +
@@ -158,11 +167,13 @@ void add_report(CLI::App& app) {
     if (!o->results.empty()) {
       if (!o->baseline.empty() || !o->write_baseline.empty())
         throw UsageError("--baseline and --write-baseline measure: give no RESULTS with them");
-      if (o->results.size() == 1)
+      for (const std::string& file : o->results) {
+        const json doc = read_json("RESULTS", file);
         for (const char* key : {"fingerprint", "matrix", "ranking"})
-          if (!read_json("RESULTS", o->results[0]).contains(key))
-            throw UsageError("RESULTS: " + o->results[0] + " has no \"" + key +
+          if (!doc.contains(key))
+            throw UsageError("RESULTS: " + file + " has no \"" + key +
                              "\": not a results file of `flatmarch report`");
+      }
       make_html(o->python, o->results, o->out);
       std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
       return;
@@ -359,21 +370,26 @@ void add_sweep(CLI::App& app) {
       throw UsageError("--repetitions: expected 1 to 100");
     if (o->sweep.params.max_steps < 1 || o->sweep.params.max_steps > (1 << 20))
       throw UsageError("--max-steps: expected 1 to 1048576");
-    if (!make_backend(o->sweep.backend, o->sweep.backend_options) || o->sweep.backend == "oracle")
+    const std::unique_ptr<Backend> backend =
+        make_backend(o->sweep.backend, o->sweep.backend_options);
+    if (!backend || o->sweep.backend == "oracle")
       throw UsageError("--backend: expected scalar, simd, opengl or vulkan, got \"" +
                        o->sweep.backend + "\"");
+    if (const Availability a = backend->availability(); !a.available)
+      throw UnavailableError("the " + o->sweep.backend +
+                             " backend is unavailable here: " + a.reason);
+    const std::vector<Precision> has = backend->precisions();
+    if (std::none_of(o->sweep.precisions.begin(), o->sweep.precisions.end(), [&](Precision p) {
+          return std::find(has.begin(), has.end(), p) != has.end();
+        }))
+      throw UsageError("--precision: the " + o->sweep.backend + " backend marches in f32 only");
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
     conformance::Suite suite;
     ProgressReporter progress("sweep", o->quiet);
-    json result;
-    try {
-      result =
-          reports::run_sweep(scenes, o->sweep, suite, [&](const std::string&, int done, int total) {
-            progress(static_cast<double>(done) / total);
-          });
-    } catch (const std::invalid_argument& e) {
-      throw UnavailableError(e.what());
-    }
+    json result =
+        reports::run_sweep(scenes, o->sweep, suite, [&](const std::string&, int done, int total) {
+          progress(static_cast<double>(done) / total);
+        });
     progress.done();
     result["fingerprint"] = reports::hardware_fingerprint();
     write_json(o->json, result);

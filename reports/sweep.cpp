@@ -61,6 +61,9 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
     const std::vector<Precision> has = backend->precisions();
     if (std::find(has.begin(), has.end(), p) != has.end()) precisions.push_back(p);
   }
+  if (precisions.empty())
+    throw std::invalid_argument("the " + o.backend +
+                                " backend marches in none of the precisions asked for");
   // Every point is judged against one truth, masked as for the default parameters.
   suite.fix_mask(MarchParams{});
   const std::vector<std::string> labels = offset_labels(o);
@@ -228,8 +231,10 @@ json analyse_sweep(const json& points) {
     struct Candidate {
       const Cell* cell;
       bool interior;
-      int margin;           // stable neighbours of the 8 around it
-      double from_default;  // |log10(eps / 1e-4)|
+      int margin;  // stable neighbours of the 8 around it
+      // |log10(eps / 1e-4)| + |log10(offset / 2e-4)|: among equals, the defaults' neighbourhood
+      // (the analytic method, which pushes no point across an edge, ignores the offset).
+      double from_default;
     };
     std::vector<Candidate> candidates;
     for (long e = 0; e < static_cast<long>(g.eps.size()); ++e)
@@ -241,7 +246,8 @@ json analyse_sweep(const json& points) {
         const Cell* c =
             &g.cells.at({g.eps[static_cast<size_t>(e)], g.labels[static_cast<size_t>(k)]});
         candidates.push_back({c, stable_at(e - 1, k) && stable_at(e + 1, k), margin,
-                              std::abs(std::log10(c->eps / MarchParams{}.eps))});
+                              std::abs(std::log10(c->eps / MarchParams{}.eps)) +
+                                  std::abs(std::log10(c->offset / MarchParams{}.offset))});
       }
     const bool any_interior = std::any_of(candidates.begin(), candidates.end(),
                                           [](const Candidate& c) { return c.interior; });
