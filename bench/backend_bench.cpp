@@ -1,8 +1,9 @@
-// Every backend x method x gallery scene, from the scene's own camera (BACKEND/METHOD/SCENE/WxH,
-// 640x360 by default): rays_per_s, steps_mean, steps_p99, crossings_mean, out_of_steps, and
-// lane_utilisation for the SIMD backend. The JSON output (--benchmark_out=FILE
-// --benchmark_out_format=json) carries the machine's fingerprint in its context; it is what
-// `flatmarch report` reads too. Unavailable backends are skipped, with the reason, on stderr.
+// Every backend x method x gallery scene (the oracle too: what the truth costs), from the
+// scene's own camera (BACKEND/METHOD/SCENE/WxH, 640x360 by default): rays_per_s, steps_mean,
+// steps_p99, crossings_mean, out_of_steps, and lane_utilisation for the SIMD backend. The JSON
+// output (--benchmark_out=FILE --benchmark_out_format=json) carries the machine's fingerprint in
+// its context; `flatmarch report` writes the same cases. Unavailable backends are skipped, with
+// the reason, on stderr.
 //
 //   build/bench/backend_bench --benchmark_filter='^simd/analytic/' --benchmark_repetitions=5
 //   build/bench/backend_bench --size=320x180 --benchmark_out=bench.json
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
   reports::add_to_benchmark_context(reports::hardware_fingerprint());
   const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
   std::vector<std::unique_ptr<Backend>> available;
-  for (const char* name : {"scalar", "simd", "opengl", "vulkan"}) {
+  for (const char* name : {"oracle", "scalar", "simd", "opengl", "vulkan"}) {
     std::unique_ptr<Backend> b = make_backend(name, {});
     if (const Availability a = b->availability(); !a.available)
       std::cerr << "backend_bench: the " << name
