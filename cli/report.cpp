@@ -210,6 +210,15 @@ void add_report(CLI::App& app) {
     r.sweep.params.max_steps = o->params.max_steps;
     r.sweep.backend_options = o->backend_options;
     if (!o->sweep_backend.empty()) r.sweep.backend = o->sweep_backend;
+    if (r.sweep_enabled) {
+      const std::unique_ptr<Backend> b = make_backend(r.sweep.backend, o->backend_options);
+      if (!b || r.sweep.backend == "oracle")
+        throw UsageError("--sweep-backend: expected scalar, simd, opengl or vulkan, got \"" +
+                         r.sweep.backend + "\"");
+      if (const Availability a = b->availability(); !a.available)
+        throw UnavailableError("--sweep-backend: the " + r.sweep.backend +
+                               " backend is unavailable here: " + a.reason);
+    }
     r.sweep.repetitions = o->full ? 3 : 2;
     std::tie(r.sweep.width, r.sweep.height) = parse_size(
         "--sweep-size", o->sweep_size.empty() ? (o->full ? "96x54" : "64x36") : o->sweep_size);
