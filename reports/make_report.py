@@ -97,7 +97,9 @@ def ranking_section(results):
     if rec.get("backend"):
         parts.append(f'<p class="choice">Use <b>{esc(rec["backend"])}</b> with the <b>{esc(rec["method"])}</b> '
                      f'method: {mrays(rec.get("rays_per_s", 0))} Mrays/s, geometric mean over the gallery. '
-                     f'{esc(rec["why"])}. <code>flatmarch select</code> prints this choice.</p>')
+                     f'{esc(rec["why"][0].upper() + rec["why"][1:])}. <code>flatmarch select</code> prints this choice.'
+                     + (" The analytic method crosses edges exactly and pushes no point: it does not use the offset."
+                        if rec["method"] == "analytic" else "") + "</p>")
         rows = []
         for t, p in rec.get("parameters", {}).items():
             src = "the sweep's recommendation" if p["source"] == "sweep" else "defaults: the sweep found no stable point"
@@ -112,7 +114,7 @@ def ranking_section(results):
                f'{b["passed"]}/{b["cases"]}' + (f' ({b["errors"]} errors)' if b["errors"] else "")]
         for m in methods:
             mm = b["methods"].get(m)
-            row.append(f'{mrays(mm["rays_per_s"])} ({mm["passed"]}/{mm["cases"]})' if mm else "-")
+            row.append(f'{mrays(mm["rays_per_s"])} ({int(mm["passed"])}/{int(mm["cases"])})' if mm else "-")
         row.append(b["best_method"] or "-")
         rows.append(row)
     parts.append("<p>Backends ranked: those that passed every conformance case first, then by the geometric "
@@ -172,7 +174,9 @@ def gallery_section(results, images):
         rows.append([f"<td>{esc(s)}</td>"] + [
             "<td>" + image_html(os.path.join(images, b, s + ".png"), f"{s}, {b}") + "</td>" for b in backends])
     return ("<h2 id=gallery>Gallery, per backend</h2><p>Each scene from its own camera, by the exact oracle "
-            f"and by each backend (sphere method, {esc(results['options']['size'])}, the timed frames).</p>"
+            f"and by each backend (sphere method, {esc(results['options']['size'])}, the timed frames). In the "
+            "translation prisms sphere tracing runs out of steps on many rays (the grey haze), which the "
+            "thresholds allow there; the analytic method does not (see the speed chart above).</p>"
             + table(["scene"] + backends, rows, "gallery"))
 
 
@@ -257,9 +261,11 @@ def sweep_section(sweep):
            "against one truth (the oracle, masked as for the default parameters). <b>Stability</b> heatmaps: the "
            "colour is the share of decided pixels whose hit is wrong (mean over the surface type's scenes, log); "
            "a tick marks a stable point (every scene passes the conformance checks but the perceptual one, "
-           "which small frames make noisy; a tick on a dark cell is an error the thresholds allow, such as the "
-           "translation prisms' rays running out of steps under sphere tracing); the star, the recommendation: the fastest stable point whose "
-           "neighbours a decade of eps either side are stable too. <b>Steps</b> heatmaps: mean kernel steps per "
+           "which small frames make noisy; a tick on a coloured cell is an error conformance/thresholds.json allows "
+           "with its reason, such as sphere tracing running out of steps near the horizon, on up to 2% of the "
+           "pixels of several scenes and most of a translation prism's); the star, the recommendation: of the stable points whose "
+           "neighbours a decade of eps either side are stable too, one within 10% of the fastest with the most stable "
+           "neighbours on the grid. <b>Steps</b> heatmaps: mean kernel steps per "
            "ray. The Pareto chart: each grid point's time against its error; the front joins the points no other "
            "beats on both.</p>"]
     rec_rows = []
@@ -341,7 +347,7 @@ def sweep_section(sweep):
         for g in groups:
             r = g.get("recommended")
             rec_rows.append([t, g["method"], g["precision"], f'{len(g["stable"])}/{len(g["grid"])}',
-                             f'{r["eps"]:g}' if r else "-", f'{r["offset"]:g} ({r["offset_label"]})' if r else "-",
+                             f'{r["eps"]:g}' if r else "-", f'{r["offset"]:g} ({r["offset_label"] if r["offset_label"].endswith("xeps") else "fixed"})' if r else "-",
                              (f'{r["time_ms"]:.3g} ms, {pct(r["hit_mismatch"])} wrong' if r else "nothing stable")])
     out.insert(1, table(["surface type", "method", "precision", "stable points", "eps", "offset", "at"], rec_rows))
     return "\n".join(out)
@@ -364,22 +370,26 @@ def scaling_section(scaling):
                     color=BACKEND_COLOURS.get(s["backend"], "k"),
                     label=f'{s["backend"]} {s["method"]}{" staircase" if "staircase" in s["family"] else ""}: '
                           f'slope {s["slope"]:.2f}')
+            lanes = s.get("lane_utilisation")
             rows.append([axis, s["family"], s["backend"], s["method"], f'{s["slope"]:.2f}', f'{s["steps_slope"]:.2f}',
                          f'{min(s["x"]):g} to {max(s["x"]):g}',
-                         f'{min(s["time_ms"]):.3g} to {max(s["time_ms"]):.3g}'])
+                         f'{s["time_ms"][0]:.3g} to {s["time_ms"][-1]:.3g}',
+                         " ".join(pct(v) for v in lanes) if lanes else "-"])
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel(label + " (log)")
         ax.set_ylabel("ms per frame (log)")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=6)
+        ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
     fig.tight_layout()
     return ("<h2 id=scaling>Scaling</h2><p>Time per frame against pixels (the gallery torus), against the "
             "number of edges (regular 2n-gons, solid; staircases of squares, each its own room, dashed; both "
             "empty translation prisms where every ray runs the same distance) and against the path length "
             "(an empty torus prism, where every ray runs max_distance). The slope is the exponent of a power-law "
-            "fit: 1 is linear.</p>" + figure_html(fig, "scaling") +
-            table(["axis", "family", "backend", "method", "time slope", "steps slope", "x", "ms"], rows))
+            "fit: 1 is linear. The SIMD backend's lanes idle when the rays of a packet are in different rooms: the last "
+            "column shows the share of its lanes at work at each point of a series.</p>" + figure_html(fig, "scaling") +
+            table(["axis", "family", "backend", "method", "time slope", "steps slope", "x", "ms", "SIMD lanes busy, per point"],
+                  rows))
 
 
 PAGE = """<!doctype html><html><head><meta charset="utf-8"><title>{title}</title><style>

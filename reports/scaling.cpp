@@ -120,7 +120,7 @@ json run_scaling(const ScalingOptions& o,
                   {"family", s.family},
                   {"backend", b->name()},
                   {"method", to_string(m)}};
-        std::vector<double> x, ms, steps, crossings;
+        std::vector<double> x, ms, steps, crossings, lanes;
         for (const Point& p : s.points) {
           const auto it = t.find(name_of(s, *b, m, p));
           if (it == t.end() || !it->second.error.empty()) continue;
@@ -128,11 +128,14 @@ json run_scaling(const ScalingOptions& o,
           ms.push_back(it->second.median_ms);
           steps.push_back(it->second.counters.value("steps_mean", 0.0));
           crossings.push_back(it->second.counters.value("crossings_mean", 0.0));
+          if (it->second.counters.contains("lane_utilisation"))
+            lanes.push_back(it->second.counters["lane_utilisation"].get<double>());
         }
         j["x"] = x;
         j["time_ms"] = ms;
         j["steps_mean"] = steps;
         j["crossings_mean"] = crossings;
+        if (!lanes.empty()) j["lane_utilisation"] = lanes;
         j["slope"] = loglog_slope(x, ms);
         j["steps_slope"] = loglog_slope(x, steps);
         out["series"].push_back(j);

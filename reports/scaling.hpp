@@ -36,7 +36,8 @@ struct ScalingOptions {
 double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);
 
 // Returns {"series": [{"axis" (pixels, edges, max_distance), "family", "backend", "method",
-// "x", "time_ms", "steps_mean", "crossings_mean", "slope" (of time_ms), "steps_slope"}],
+// "x", "time_ms", "steps_mean", "crossings_mean", "lane_utilisation" (SIMD), "slope" (of time_ms),
+// "steps_slope"}],
 // "skipped": [...], "benchmarks": Google Benchmark's JSON}.
 nlohmann::json run_scaling(const ScalingOptions& options,
                            const std::function<void(const std::string&, int, int)>& progress);
