@@ -7,13 +7,15 @@
 #include <algorithm>
 #include <filesystem>
 #include <memory>
-#include <numeric>
 #include <vector>
 
 #include "backends/backend.hpp"
+#include "reports/matrix.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::bench {
+
+using reports::frame_counters;  // the counters every benchmark program reports
 
 // Frames are renders' largest allocations (7 MB at 640x360). By default glibc gives memory that
 // big back to the system when it is freed and maps it afresh for the next frame, whose pages
@@ -42,21 +44,6 @@ inline std::vector<std::unique_ptr<Scene>> load_gallery() {
   std::vector<std::unique_ptr<Scene>> scenes;
   for (const auto& f : files) scenes.push_back(std::make_unique<Scene>(load_scene(f)));
   return scenes;
-}
-
-// rays_per_s, and the deterministic figures of the last frame: steps_mean, steps_p99,
-// out_of_steps (share of rays that reached max_steps).
-inline void frame_counters(benchmark::State& state, const Frame& frame) {
-  std::vector<float> steps(frame.steps.begin(), frame.steps.end());
-  std::sort(steps.begin(), steps.end());
-  const double pixels = static_cast<double>(steps.size());
-  state.counters["rays_per_s"] =
-      benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["steps_mean"] = std::accumulate(steps.begin(), steps.end(), 0.0) / pixels;
-  state.counters["steps_p99"] = steps[static_cast<size_t>(0.99 * (pixels - 1))];
-  state.counters["out_of_steps"] =
-      static_cast<double>(std::count(frame.hit.begin(), frame.hit.end(), float(kHitMaxSteps))) /
-      pixels;
 }
 
 }  // namespace flatmarch::bench

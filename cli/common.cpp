@@ -236,6 +236,18 @@ std::vector<Scene> load_scenes(const std::vector<std::string>& names,
   return scenes;
 }
 
+std::vector<Method> parse_methods(const std::vector<std::string>& names) {
+  std::vector<Method> methods;
+  for (const std::string& name : names) {
+    const auto m = parse_method(name);
+    if (!m || *m == Method::oracle)
+      throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + name + "\"");
+    methods.push_back(*m);
+  }
+  if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
+  return methods;
+}
+
 ProgressReporter::ProgressReporter(std::string label, bool quiet)
     : label_(std::move(label)),
       quiet_(quiet),

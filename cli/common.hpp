@@ -40,6 +40,10 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
 std::vector<Scene> load_scenes(const std::vector<std::string>& names,
                                const std::vector<std::string>& galleries);
 
+// The kernel methods named by --method options (UsageError for another name); all three when
+// none is named.
+std::vector<Method> parse_methods(const std::vector<std::string>& names);
+
 // Throws UsageError for parameters out of range; warns (stderr) when offset <= eps.
 void check_march_params(const MarchParams& params);
 

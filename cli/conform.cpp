@@ -96,14 +96,7 @@ void add_conform(CLI::App& app) {
       o->params.precision = Precision::f64;
     else if (o->precision != "f32")
       throw UsageError("--precision: expected f32 or f64, got \"" + o->precision + "\"");
-    std::vector<Method> methods;
-    for (const std::string& name : o->methods) {
-      const auto m = parse_method(name);
-      if (!m || *m == Method::oracle)
-        throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + name + "\"");
-      methods.push_back(*m);
-    }
-    if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
+    const std::vector<Method> methods = parse_methods(o->methods);
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
     if (std::any_of(methods.begin(), methods.end(), [](Method m) { return m != Method::analytic; }))
       for (const Scene& scene : scenes) {

@@ -37,18 +37,6 @@ void write_json(const fs::path& file, const json& doc) {
   if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 
-std::vector<Method> parse_methods(const std::vector<std::string>& names) {
-  std::vector<Method> methods;
-  for (const std::string& name : names) {
-    const auto m = parse_method(name);
-    if (!m || *m == Method::oracle)
-      throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + name + "\"");
-    methods.push_back(*m);
-  }
-  if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
-  return methods;
-}
-
 // A word for the shell, quoted.
 std::string quoted(const std::string& word) {
   std::string q = "'";

@@ -54,21 +54,6 @@ std::string case_name(const std::string& backend, Method method, const std::stri
 
 namespace {
 
-void frame_counters(benchmark::State& state, const Frame& frame) {
-  std::vector<float> steps(frame.steps.begin(), frame.steps.end());
-  std::sort(steps.begin(), steps.end());
-  const double pixels = static_cast<double>(steps.size());
-  state.counters["rays_per_s"] =
-      benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["steps_mean"] = std::accumulate(steps.begin(), steps.end(), 0.0) / pixels;
-  state.counters["steps_p99"] = steps[static_cast<size_t>(0.99 * (pixels - 1))];
-  state.counters["crossings_mean"] =
-      std::accumulate(frame.crossings.begin(), frame.crossings.end(), 0.0) / pixels;
-  state.counters["out_of_steps"] =
-      static_cast<double>(std::count(frame.hit.begin(), frame.hit.end(), float(kHitMaxSteps))) /
-      pixels;
-}
-
 // Collects Google Benchmark's JSON and says when each run ends.
 class CollectingReporter : public benchmark::JSONReporter {
  public:
@@ -96,37 +81,54 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                               double min_time, Frame* last, const std::string& name) {
   const auto* simd = dynamic_cast<const SimdBackend*>(&backend);
   auto warmed = std::make_shared<bool>(false);
-  benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
-      (name.empty() ? case_name(backend.name(), params.method, scene.name, width, height) : name)
-          .c_str(),
-      [&backend, &scene, camera, params, width, height, last, simd,
-       warmed](benchmark::State& state) {
-        // A backend's error (a failed compile, a lost device) ends the case, not the run.
-        Frame f;
-        try {
-          if (!*warmed) f = backend.render(scene, camera, width, height, params, {});
-          *warmed = true;
-          for (auto _ : state) {
-            f = backend.render(scene, camera, width, height, params, {});
-            benchmark::DoNotOptimize(f.rgb.data());
-          }
-          if (simd) {
-            simd::LaneCounts lanes;
-            simd->render_counted(scene, camera, width, height, params, {}, lanes);
-            state.counters["lane_utilisation"] =
-                static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
-          }
-        } catch (const std::exception& e) {
-          state.SkipWithError(e.what());
-          return;
-        }
-        frame_counters(state, f);
-        if (last) *last = std::move(f);
-      })
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
+  benchmark::internal::Benchmark* b =
+      benchmark::RegisterBenchmark(
+          (name.empty() ? case_name(backend.name(), params.method, scene.name, width, height)
+                        : name)
+              .c_str(),
+          [&backend, &scene, camera, params, width, height, last, simd,
+           warmed](benchmark::State& state) {
+            // A backend's error (a failed compile, a lost device) ends the case, not the run.
+            Frame f;
+            try {
+              if (!*warmed) f = backend.render(scene, camera, width, height, params, {});
+              *warmed = true;
+              for (auto _ : state) {
+                f = backend.render(scene, camera, width, height, params, {});
+                benchmark::DoNotOptimize(f.rgb.data());
+              }
+              if (simd) {
+                simd::LaneCounts lanes;
+                simd->render_counted(scene, camera, width, height, params, {}, lanes);
+                state.counters["lane_utilisation"] =
+                    static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
+              }
+            } catch (const std::exception& e) {
+              state.SkipWithError(e.what());
+              return;
+            }
+            frame_counters(state, f);
+            if (last) *last = std::move(f);
+          })
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   if (min_time > 0.0) b->MinTime(min_time);
   if (repetitions > 0) b->Repetitions(repetitions);
+}
+
+void frame_counters(benchmark::State& state, const Frame& frame) {
+  std::vector<float> steps(frame.steps.begin(), frame.steps.end());
+  std::sort(steps.begin(), steps.end());
+  const double pixels = static_cast<double>(steps.size());
+  state.counters["rays_per_s"] =
+      benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["steps_mean"] = std::accumulate(steps.begin(), steps.end(), 0.0) / pixels;
+  state.counters["steps_p99"] = steps[static_cast<size_t>(0.99 * (pixels - 1))];
+  state.counters["crossings_mean"] =
+      std::accumulate(frame.crossings.begin(), frame.crossings.end(), 0.0) / pixels;
+  state.counters["out_of_steps"] =
+      static_cast<double>(std::count(frame.hit.begin(), frame.hit.end(), float(kHitMaxSteps))) /
+      pixels;
 }
 
 json run_registered_benchmarks(const std::function<void(const std::string&)>& on_run) {

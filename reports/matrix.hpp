@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <benchmark/benchmark.h>
+
 #include "backends/backend.hpp"
 #include "conformance/suite.hpp"
 
@@ -59,6 +61,11 @@ nlohmann::json run_registered_benchmarks(const std::function<void(const std::str
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
                               const MarchParams& params, int width, int height, int repetitions,
                               double min_time, Frame* last = nullptr, const std::string& name = "");
+
+// The counters of a timed frame: rays_per_s (a rate over the iterations), and the deterministic
+// figures of the frame: steps_mean, steps_p99, crossings_mean, out_of_steps (share of rays that
+// reached max_steps).
+void frame_counters(benchmark::State& state, const Frame& frame);
 
 // The name register_frame_benchmark gives.
 std::string case_name(const std::string& backend, Method method, const std::string& scene,
