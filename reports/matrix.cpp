@@ -202,8 +202,11 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
   const int total = static_cast<int>(backends.size() * scenes.size() * o.methods.size());
   std::map<std::string, json> cases;
   std::vector<std::string> order;
-  // Frames kept for the gallery images, by case name (sphere method only).
+  // Frames kept for the gallery images, by case name (the first method's).
   std::map<std::string, Frame> frames;
+  const int steps = (o.conformance ? total : 0) + (o.timing ? total : 0);
+  int done = 0;
+  // Each case is measured against the oracle now and registered for timing, which runs after.
   for (const auto& backend : backends)
     for (const Scene& scene : scenes)
       for (const Method m : o.methods) {
@@ -211,41 +214,32 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
         params.method = m;
         const std::string name = case_name(backend->name(), m, scene.name, o.width, o.height);
         order.push_back(name);
-        cases[name] = {{"name", name},           {"backend", backend->name()},
-                       {"scene", scene.name},    {"surface_type", surface_type(scene)},
-                       {"method", to_string(m)}, {"width", o.width},
-                       {"height", o.height}};
+        json& c = cases[name];
+        c = {{"name", name},           {"backend", backend->name()},
+             {"scene", scene.name},    {"surface_type", surface_type(scene)},
+             {"method", to_string(m)}, {"width", o.width},
+             {"height", o.height}};
         if (o.timing) {
           Frame* keep = nullptr;
           if (!o.images.empty() && m == o.methods.front()) keep = &frames[name];
           register_frame_benchmark(*backend, scene, scene.camera, params, o.width, o.height,
                                    o.repetitions, o.min_time, keep);
         }
-      }
-  int done = 0;
-  if (o.conformance)
-    for (const auto& backend : backends)
-      for (const Scene& scene : scenes)
-        for (const Method m : o.methods) {
-          MarchParams params = o.params;
-          params.method = m;
-          const std::string name = case_name(backend->name(), m, scene.name, o.width, o.height);
-          json& c = cases[name];
-          try {
-            c["accuracy"] = accuracy_summary(
-                suite.run(*backend, scene, params, o.conform_width, o.conform_height));
-            c["accuracy"]["size"] =
-                std::to_string(o.conform_width) + "x" + std::to_string(o.conform_height);
-          } catch (const std::exception& e) {
-            c["error"] = e.what();
-          }
-          if (progress)
-            progress("conformance " + name + (c.contains("error") ? ": error" : ""), ++done,
-                     o.timing ? 2 * total : total);
+        if (!o.conformance) continue;
+        try {
+          c["accuracy"] = accuracy_summary(
+              suite.run(*backend, scene, params, o.conform_width, o.conform_height));
+          c["accuracy"]["size"] =
+              std::to_string(o.conform_width) + "x" + std::to_string(o.conform_height);
+        } catch (const std::exception& e) {
+          c["error"] = e.what();
         }
+        if (progress)
+          progress("conformance " + name + (c.contains("error") ? ": error" : ""), ++done, steps);
+      }
   if (o.timing) {
     out["benchmarks"] = run_registered_benchmarks([&](const std::string& name) {
-      if (progress) progress("timed " + name, ++done, o.conformance ? 2 * total : total);
+      if (progress) progress("timed " + name, ++done, steps);
     });
     for (const auto& [name, t] : timings(out["benchmarks"])) {
       if (!cases.count(name)) continue;

@@ -28,8 +28,8 @@ struct MatrixOptions {
   double min_time = 0.02;   // seconds per repetition, at least one frame
   bool conformance = true;  // measure against the oracle too
   bool timing = true;
-  // Where to write each backend's frame of each scene (sphere method) as BACKEND/SCENE.png; empty:
-  // nowhere.
+  // Where to write each backend's frame of each scene (the first method's) as BACKEND/SCENE.png;
+  // empty: nowhere.
   std::filesystem::path images;
 };
 
