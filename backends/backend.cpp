@@ -61,15 +61,6 @@ const char* to_string(EventKind k) {
   return name_of(kEventKinds, k);
 }
 
-Frame::Frame(int w, int h)
-    : width(w),
-      height(h),
-      rgb(3 * static_cast<size_t>(w) * static_cast<size_t>(h)),
-      steps(static_cast<size_t>(w) * static_cast<size_t>(h)),
-      crossings(steps.size()),
-      hit(steps.size()),
-      t(steps.size()) {}
-
 Trace kernel_trace(const std::vector<kernel::KernelEvent>& events, int steps) {
   Trace trace;
   trace.steps = steps;
@@ -111,7 +102,7 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOpti
   if (name == "oracle") return std::make_unique<OracleBackend>();
   if (name == "scalar") return std::make_unique<ScalarBackend>();
   if (name == "simd") return std::make_unique<SimdBackend>(options);
-  if (name == "opengl") return std::make_unique<OpenGlBackend>();
+  if (name == "opengl") return std::make_unique<OpenGlBackend>(options);
   if (name == "vulkan") return std::make_unique<VulkanBackend>(options);
   return nullptr;
 }

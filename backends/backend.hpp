@@ -97,8 +97,16 @@ struct Frame {
   Channel steps, crossings, hit, t;
 
   Frame() = default;
-  // Every pixel must then be written (set).
-  Frame(int w, int h);
+  // Every pixel must then be written (set). Inline: the image module (output/image_library.hpp)
+  // makes frames without linking the backends.
+  Frame(int w, int h)
+      : width(w),
+        height(h),
+        rgb(3 * static_cast<size_t>(w) * static_cast<size_t>(h)),
+        steps(static_cast<size_t>(w) * static_cast<size_t>(h)),
+        crossings(steps.size()),
+        hit(steps.size()),
+        t(steps.size()) {}
   size_t pixel(int i, int j) const {
     return static_cast<size_t>(j) * static_cast<size_t>(width) + static_cast<size_t>(i);
   }
@@ -113,6 +121,16 @@ struct Frame {
   }
 };
 
+// The device a GPU backend runs on, named beside every figure it produces.
+struct DeviceInfo {
+  std::string name;       // "llvmpipe (LLVM 15.0.6, 256 bits)", "NVIDIA H100 80GB HBM3"
+  std::string type;       // "GPU" or "CPU" (OpenGL); Vulkan's device type ("discrete GPU", ...)
+  std::string api;        // "OpenGL 4.5 (Core Profile) Mesa 22.3.6", "Vulkan 1.3.230"
+  std::string driver;     // "Mesa 22.3.6", "NVIDIA 550.54.15", "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)"
+  std::string platform;   // how the backend reached it: "EGL device", "OSMesa", "Vulkan"
+  bool software = false;  // a rasteriser running on the CPU (llvmpipe, lavapipe, SwiftShader)
+};
+
 struct Availability {
   bool available = true;
   std::string reason;  // why not, when unavailable
@@ -122,9 +140,13 @@ struct Availability {
 struct BackendOptions {
   std::string isa{};  // simd: the instruction set (see `flatmarch backends`); empty: the best here
   int threads = 0;    // simd: worker threads; 0: all cores
-  // vulkan: the device, by its index or a part of its name (see `flatmarch backends`); empty: a
-  // discrete GPU if there is one, else an integrated, a virtual GPU, the CPU (lavapipe).
+  // opengl and vulkan: the device, by its index or a part of its name (see `flatmarch
+  // backends`); empty: a GPU if there is one (vulkan: discrete, integrated, virtual), else the CPU
+  // (llvmpipe through EGL, then OSMesa; lavapipe).
   std::string device{};
+  // vulkan: read frames back through a staging buffer even where the device's memory is
+  // host-visible, as on a discrete GPU (so that the path is tested on any device).
+  bool vk_staging = false;
   // vulkan: run under the Khronos validation layer, and fail a frame or trace on any message it
   // sends. Also on when the environment sets FLATMARCH_VULKAN_VALIDATION=1.
   bool validation = false;
@@ -143,6 +165,8 @@ class Backend {
   virtual std::vector<Method> methods() const = 0;
   // Precisions it marches in.
   virtual std::vector<Precision> precisions() const { return {Precision::f32, Precision::f64}; }
+  // The device it runs on (GPU backends, when available); CPU backends: none.
+  virtual std::optional<DeviceInfo> device() const { return std::nullopt; }
 
   virtual Frame render(const Scene& scene, const Camera& camera, int width, int height,
                        const MarchParams& params, const Progress& progress) const = 0;

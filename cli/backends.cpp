@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/backend.hpp"
+#include "backends/opengl/context.hpp"
+#include "backends/opengl/opengl.hpp"
 #include "backends/simd/simd.hpp"
 #include "backends/vulkan/vulkan.hpp"
 #include "cli/commands.hpp"
@@ -27,6 +29,25 @@ void add_backends(CLI::App& app) {
                       {"methods", methods},
                       {"description", b->description()}});
       if (b->name() == "simd") list.back()["isas"] = simd::isa_names(true);
+      if (const auto device = b->device())
+        list.back()["device"] = {{"name", device->name},         {"type", device->type},
+                                 {"api", device->api},           {"driver", device->driver},
+                                 {"platform", device->platform}, {"software", device->software}};
+      if (const auto* opengl = dynamic_cast<const OpenGlBackend*>(b.get())) {
+        nlohmann::json devices = nlohmann::json::array();
+        for (const gl::Device& d : gl::list_devices())
+          devices.push_back({{"index", d.index},
+                             {"platform", d.platform},
+                             {"node", d.node},
+                             {"vendor", d.vendor},
+                             {"renderer", d.renderer},
+                             {"version", d.version},
+                             {"software", d.software},
+                             {"usable", d.usable},
+                             {"reason", d.reason},
+                             {"default", d.index == opengl->device_index()}});
+        list.back()["devices"] = devices;
+      }
       if (const auto* vulkan = dynamic_cast<const VulkanBackend*>(b.get())) {
         nlohmann::json devices = nlohmann::json::array();
         for (const vulkan::Device& d : vulkan->devices())
@@ -61,20 +82,38 @@ void add_backends(CLI::App& app) {
     std::printf("\nsimd instruction sets this CPU runs (--isa), best first: %s\n", isas.c_str());
     for (const auto& b : list) {
       if (!b.contains("devices")) continue;
+      const std::string name = b["name"].get<std::string>();
       if (b["devices"].empty()) {
-        std::printf("\nvulkan devices (--device): none\n");
+        std::printf("\n%s devices (--device): none\n", name.c_str());
         continue;
       }
-      std::printf("\nvulkan devices (--device), * the default:\n");
-      for (const auto& d : b["devices"])
+      std::printf("\n%s devices (--device), * the default:\n", name.c_str());
+      for (const auto& d : b["devices"]) {
+        const bool is_default = d["default"].get<bool>();
+        const int index = d["index"].get<int>();
+        if (name == "opengl") {
+          const std::string node = d["node"].get<std::string>();
+          const std::string where =
+              d["platform"].get<std::string>() + (node.empty() ? "" : " " + node);
+          if (!d["usable"].get<bool>()) {
+            std::printf("  %s %d  %s  not usable: %s\n", is_default ? "*" : " ", index,
+                        where.c_str(), d["reason"].get<std::string>().c_str());
+            continue;
+          }
+          std::printf("  %s %d  %s  (%s, %s, OpenGL %s%s)\n", is_default ? "*" : " ", index,
+                      d["renderer"].get<std::string>().c_str(), where.c_str(),
+                      d["vendor"].get<std::string>().c_str(),
+                      d["version"].get<std::string>().c_str(),
+                      d["software"].get<bool>() ? ", software" : "");
+          continue;
+        }
+        const std::string driver = d["driver"].get<std::string>();
         std::printf(
-            "  %s %d  %s  (%s, Vulkan %s%s)%s\n", d["default"].get<bool>() ? "*" : " ",
-            d["index"].get<int>(), d["name"].get<std::string>().c_str(),
-            d["type"].get<std::string>().c_str(), d["api"].get<std::string>().c_str(),
-            d["driver"].get<std::string>().empty()
-                ? ""
-                : (", " + d["driver"].get<std::string>()).c_str(),
+            "  %s %d  %s  (%s, Vulkan %s%s)%s\n", is_default ? "*" : " ", index,
+            d["name"].get<std::string>().c_str(), d["type"].get<std::string>().c_str(),
+            d["api"].get<std::string>().c_str(), driver.empty() ? "" : (", " + driver).c_str(),
             d["usable"].get<bool>() ? "" : "  not usable: no Vulkan 1.1 or no compute queue");
+      }
     }
   });
 }

@@ -95,8 +95,12 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
   app.add_option("--threads", backend_options.threads, "simd: worker threads (0: all cores)")
       ->capture_default_str();
   app.add_option("--device", backend_options.device,
-                 "vulkan: the device, by its index or a part of its name as `flatmarch backends` "
-                 "lists them (default: a discrete GPU, else an integrated one, else the CPU)");
+                 "opengl, vulkan: the device, by its index or a part of its name as `flatmarch "
+                 "backends` lists them (default: a GPU, else the CPU: llvmpipe through EGL, then "
+                 "OSMesa; lavapipe)");
+  app.add_flag("--vk-staging", backend_options.vk_staging,
+               "vulkan: read frames back through a staging buffer, as on a discrete GPU, even "
+               "where the device's memory is host-visible");
 }
 
 void check_march_params(const MarchParams& params) {

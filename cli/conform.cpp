@@ -87,7 +87,11 @@ void add_conform(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--isa", o->backend_options.isa, "simd: the instruction set");
   cmd->add_option("--threads", o->backend_options.threads, "simd: worker threads (0: all cores)");
-  cmd->add_option("--device", o->backend_options.device, "vulkan: the device");
+  cmd->add_option("--device", o->backend_options.device,
+                  "opengl, vulkan: the device, by its index or a part of its name (see "
+                  "`flatmarch backends`)");
+  cmd->add_flag("--vk-staging", o->backend_options.vk_staging,
+                "vulkan: read frames back through a staging buffer, as on a discrete GPU");
   cmd->add_flag("-q,--quiet", o->quiet, "Only the summary line");
   cmd->callback([o] {
     const auto [w, h] = parse_size("--size", o->size);

@@ -149,7 +149,11 @@ void add_report(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--isa", o->backend_options.isa, "simd: the instruction set");
   cmd->add_option("--threads", o->backend_options.threads, "simd: worker threads (0: all cores)");
-  cmd->add_option("--device", o->backend_options.device, "vulkan: the device");
+  cmd->add_option("--device", o->backend_options.device,
+                  "opengl, vulkan: the device, by its index or a part of its name (see "
+                  "`flatmarch backends`)");
+  cmd->add_flag("--vk-staging", o->backend_options.vk_staging,
+                "vulkan: read frames back through a staging buffer, as on a discrete GPU");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
     if (!o->results.empty()) {
@@ -343,7 +347,11 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--max-steps", o->sweep.params.max_steps, "Kernel iterations")
       ->capture_default_str();
   cmd->add_option("--isa", o->sweep.backend_options.isa, "simd: the instruction set");
-  cmd->add_option("--device", o->sweep.backend_options.device, "vulkan: the device");
+  cmd->add_option("--device", o->sweep.backend_options.device,
+                  "opengl, vulkan: the device, by its index or a part of its name (see "
+                  "`flatmarch backends`)");
+  cmd->add_flag("--vk-staging", o->sweep.backend_options.vk_staging,
+                "vulkan: read frames back through a staging buffer, as on a discrete GPU");
   cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {

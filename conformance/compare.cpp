@@ -4,8 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
+#include "output/image_library.hpp"
 
 namespace flatmarch::conformance {
 
@@ -16,13 +15,6 @@ bool is_object(int hit) {
 }
 bool is_escape(int hit) {
   return hit == kHitEscape || hit == kHitMiss || hit == kHitMaxDistance;
-}
-
-OIIO::ImageBuf colour_image(const Frame& f) {
-  OIIO::ImageBuf image(OIIO::ImageSpec(f.width, f.height, 3, OIIO::TypeDesc::FLOAT));
-  image.set_pixels(OIIO::ROI(0, f.width, 0, f.height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
-                   f.rgb.data());
-  return image;
 }
 
 double quantile(const std::vector<float>& sorted, double q) {
@@ -101,19 +93,17 @@ ImageComparison compare_images(const Frame& got, const Frame& truth,
       ++c.masked;
       for (size_t k = 0; k < 3; ++k) masked.rgb[3 * px + k] = truth.rgb[3 * px + k];
     }
-  const OIIO::ImageBuf a = colour_image(masked), b = colour_image(truth);
-  const OIIO::ImageBufAlgo::CompareResults r =
-      OIIO::ImageBufAlgo::compare(a, b, static_cast<float>(t.fail), static_cast<float>(t.warn));
-  c.mean_error = r.meanerror;
+  const ColourComparison r = image_library().compare(masked, truth, static_cast<float>(t.fail),
+                                                     static_cast<float>(t.warn));
+  c.mean_error = r.mean_error;
   c.rms_error = r.rms_error;
-  c.psnr = r.PSNR;
-  c.max_error = r.maxerror;
-  c.max_x = r.maxx;
-  c.max_y = r.maxy;
-  c.warn = r.nwarn;
-  c.fail = r.nfail;
-  OIIO::ImageBufAlgo::CompareResults yee;
-  c.perceptual = static_cast<size_t>(std::max(0, OIIO::ImageBufAlgo::compare_Yee(a, b, yee)));
+  c.psnr = r.psnr;
+  c.max_error = r.max_error;
+  c.max_x = r.max_x;
+  c.max_y = r.max_y;
+  c.warn = r.warn;
+  c.fail = r.fail;
+  c.perceptual = r.perceptual;
   const double percent = 100.0 / static_cast<double>(std::max<size_t>(c.pixels, 1));
   c.failed = static_cast<double>(c.fail) * percent > t.failpercent || c.max_error > t.hardfail;
   c.warned = static_cast<double>(c.warn) * percent > t.warnpercent;

@@ -1,25 +1,72 @@
 #include "output/image_io.hpp"
 
-#include <stdexcept>
+#include <dlfcn.h>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "backends/dynamic_library.hpp"
+#include "output/image_library.hpp"
 
 namespace flatmarch {
 
 namespace {
 
-constexpr const char* kAovChannels[] = {"R", "G", "B", "steps", "crossings", "hit", "t"};
-constexpr int kAovCount = 7;
+// Where the module may be, in the order tried.
+std::vector<std::string> module_paths() {
+  std::vector<std::string> paths;
+  if (const char* dir = std::getenv("FLATMARCH_MODULE_DIR"); dir != nullptr && *dir != '\0')
+    paths.push_back(std::string(dir) + "/flatmarch_image.so");
+  paths.push_back(std::string(FLATMARCH_MODULE_DIR) + "/flatmarch_image.so");
+  if (const std::string dir = program_directory(); !dir.empty())
+    paths.push_back(dir + "/../lib/flatmarch_image.so");
+  return paths;
+}
 
-void check(bool ok, const OIIO::ImageBuf& buf, const std::filesystem::path& path,
-           const char* doing) {
-  if (!ok)
-    throw std::runtime_error("cannot " + std::string(doing) + " " + path.string() + ": " +
-                             buf.geterror());
+const ImageLibrary* load() {
+  std::string why;
+  for (const std::string& path : module_paths()) {
+    if (!std::filesystem::exists(path)) {
+      why += "\n  " + path + ": no such file";
+      continue;
+    }
+    void* handle = dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);  // never closed
+    if (handle == nullptr) {
+      const char* e = dlerror();
+      why += "\n  " + path + ": " + (e ? e : "cannot be loaded");
+      continue;
+    }
+    const auto entry = reinterpret_cast<decltype(&flatmarch_image_library)>(
+        dlsym(handle, "flatmarch_image_library"));
+    const ImageLibrary* library = entry ? entry() : nullptr;
+    if (library == nullptr || library->abi != kImageLibraryAbi) {
+      why += "\n  " + path + ": not this build's image module (rebuild flatmarch)";
+      continue;
+    }
+    return library;
+  }
+  throw std::runtime_error(
+      "image input and output need flatmarch's image module (OpenImageIO), "
+      "which cannot be loaded:" +
+      why);
 }
 
 }  // namespace
+
+const ImageLibrary& image_library() {
+  static const std::pair<const ImageLibrary*, std::string> loaded = []() {
+    try {
+      return std::pair<const ImageLibrary*, std::string>(load(), "");
+    } catch (const std::exception& e) {
+      return std::pair<const ImageLibrary*, std::string>(nullptr, e.what());
+    }
+  }();
+  if (loaded.first == nullptr) throw std::runtime_error(loaded.second);
+  return *loaded.first;
+}
 
 std::filesystem::path aov_path(const std::filesystem::path& png) {
   std::filesystem::path exr = png;
@@ -27,55 +74,16 @@ std::filesystem::path aov_path(const std::filesystem::path& png) {
 }
 
 void write_png(const Frame& frame, const std::filesystem::path& png) {
-  const OIIO::ImageSpec spec(frame.width, frame.height, 3, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf linear(spec, const_cast<float*>(frame.rgb.data()));
-  OIIO::ImageBuf srgb = OIIO::ImageBufAlgo::colorconvert(linear, "linear", "sRGB");
-  check(!srgb.has_error(), srgb, png, "convert the colours of");
-  srgb = OIIO::ImageBufAlgo::clamp(srgb, 0.0f, 1.0f);
-  srgb.set_write_format(OIIO::TypeDesc::UINT8);
-  check(srgb.write(png.string()), srgb, png, "write");
+  image_library().write_png(frame, png.string());
 }
 
 void write_aov_exr(const Frame& frame, const std::filesystem::path& exr) {
-  OIIO::ImageSpec spec(frame.width, frame.height, kAovCount, OIIO::TypeDesc::FLOAT);
-  spec.channelnames.assign(std::begin(kAovChannels), std::end(kAovChannels));
-  spec.attribute("compression", "zip");
-  OIIO::ImageBuf buf(spec);
-  std::vector<float> pixel(kAovCount);
-  for (int j = 0; j < frame.height; ++j)
-    for (int i = 0; i < frame.width; ++i) {
-      const size_t px = frame.pixel(i, j);
-      pixel = {frame.rgb[3 * px], frame.rgb[3 * px + 1], frame.rgb[3 * px + 2],
-               frame.steps[px],   frame.crossings[px],   frame.hit[px],
-               frame.t[px]};
-      buf.setpixel(i, j, pixel.data());
-    }
-  check(buf.write(exr.string()), buf, exr, "write");
+  image_library().write_aov_exr(frame, exr.string());
 }
 
 Frame read_aov_exr(const std::filesystem::path& exr) {
-  OIIO::ImageBuf buf(exr.string());
-  check(buf.read(0, 0, true, OIIO::TypeDesc::FLOAT), buf, exr, "read");
-  // OpenEXR keeps channels sorted by name, so look each one up.
-  const OIIO::ImageSpec& spec = buf.spec();
-  int index[kAovCount];
-  for (int k = 0; k < kAovCount; ++k) {
-    index[k] = spec.channelindex(kAovChannels[k]);
-    if (index[k] < 0) throw std::runtime_error(exr.string() + ": no channel " + kAovChannels[k]);
-  }
-  Frame frame(spec.width, spec.height);
-  std::vector<float> pixel(static_cast<size_t>(spec.nchannels));
-  for (int j = 0; j < frame.height; ++j)
-    for (int i = 0; i < frame.width; ++i) {
-      buf.getpixel(i, j, pixel.data(), spec.nchannels);
-      const auto channel = [&](int k) { return pixel[static_cast<size_t>(index[k])]; };
-      const size_t px = frame.pixel(i, j);
-      for (int k = 0; k < 3; ++k) frame.rgb[3 * px + static_cast<size_t>(k)] = channel(k);
-      frame.steps[px] = channel(3);
-      frame.crossings[px] = channel(4);
-      frame.hit[px] = channel(5);
-      frame.t[px] = channel(6);
-    }
+  Frame frame;
+  image_library().read_aov_exr(exr.string(), frame);
   return frame;
 }
 

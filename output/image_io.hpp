@@ -1,5 +1,6 @@
 // Writing frames (DESIGN.md section 4): the colour as an 8-bit sRGB PNG and every AOV in one
-// multi-channel float EXR beside it (out.png -> out.exr), both through OpenImageIO.
+// multi-channel float EXR beside it (out.png -> out.exr), both through OpenImageIO (loaded on
+// first use: image_library.hpp).
 #pragma once
 
 #include <filesystem>

@@ -2,7 +2,6 @@
 
 #include <sys/utsname.h>
 
-#include <OpenImageIO/oiioversion.h>
 #include <benchmark/benchmark.h>
 #include <glslang/build_info.h>
 #include <hwy/highway.h>
@@ -16,6 +15,7 @@
 #include "backends/opengl/opengl.hpp"
 #include "backends/simd/simd.hpp"
 #include "backends/vulkan/vulkan.hpp"
+#include "output/image_library.hpp"
 
 namespace flatmarch::reports {
 
@@ -28,6 +28,15 @@ std::string cpu_model() {
       if (const size_t colon = line.find(':'); colon != std::string::npos)
         return line.substr(line.find_first_not_of(" \t", colon + 1));
   return "unknown";
+}
+
+// The OpenImageIO the image module loads, or why it cannot.
+std::string image_library_version() {
+  try {
+    return image_library().version();
+  } catch (const std::exception& e) {
+    return std::string("unavailable: ") + e.what();
+  }
 }
 
 std::string version(int major, int minor, int patch) {
@@ -62,7 +71,7 @@ nlohmann::json hardware_fingerprint() {
     fp["host"] = os.nodename;
   }
   fp["libraries"] = {
-      {"OpenImageIO", OIIO_VERSION_STRING},
+      {"OpenImageIO", image_library_version()},
       {"oneTBB", version(TBB_VERSION_MAJOR, TBB_VERSION_MINOR, TBB_VERSION_PATCH)},
       {"Highway", version(HWY_MAJOR, HWY_MINOR, HWY_PATCH)},
       {"glslang", version(GLSLANG_VERSION_MAJOR, GLSLANG_VERSION_MINOR, GLSLANG_VERSION_PATCH)},

@@ -10,9 +10,6 @@
 #include <memory>
 #include <string>
 
-#define GLFW_INCLUDE_NONE
-#include <GLFW/glfw3.h>
-
 #include <nlohmann/json.hpp>
 
 #include "backends/opengl/gl_api.hpp"
@@ -22,6 +19,7 @@
 #include "output/image_io.hpp"
 #include "scene/load.hpp"
 #include "viewer/controls.hpp"
+#include "viewer/glfw_api.hpp"
 #include "viewer/inset.hpp"
 #include "viewer/walk.hpp"
 
@@ -89,14 +87,19 @@ void on_glfw_error(int, const char* description) {
 }
 
 void* gl_proc(const char* name) {
-  return reinterpret_cast<void*>(glfwGetProcAddress(name));
+  return reinterpret_cast<void*>(glfw().GetProcAddress(name));
 }
 
 // GLFW, initialised for the viewer's lifetime.
 struct Glfw {
   Glfw() {
-    glfwSetErrorCallback(on_glfw_error);
-    if (glfwInit() == GLFW_TRUE) return;
+    try {
+      glfw();
+    } catch (const std::exception& e) {
+      throw Unavailable(std::string("the viewer cannot open a window: ") + e.what());
+    }
+    glfw().SetErrorCallback(on_glfw_error);
+    if (glfw().Init() == GLFW_TRUE) return;
     const bool no_display = !std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY");
     throw Unavailable(
         "the viewer cannot open a window: " + last_glfw_error +
@@ -104,13 +107,13 @@ struct Glfw {
                       "under a virtual display: xvfb-run -a flatmarch view ...)"
                     : ""));
   }
-  ~Glfw() { glfwTerminate(); }
+  ~Glfw() { glfw().Terminate(); }
   Glfw(const Glfw&) = delete;
   Glfw& operator=(const Glfw&) = delete;
 };
 
 struct WindowDeleter {
-  void operator()(GLFWwindow* w) const { glfwDestroyWindow(w); }
+  void operator()(GLFWwindow* w) const { glfw().DestroyWindow(w); }
 };
 
 bool same_params(const MarchParams& a, const MarchParams& b) {
@@ -203,7 +206,7 @@ class Viewer {
 };
 
 Viewer& viewer_of(GLFWwindow* window) {
-  return *static_cast<Viewer*>(glfwGetWindowUserPointer(window));
+  return *static_cast<Viewer*>(glfw().GetWindowUserPointer(window));
 }
 
 Viewer::Viewer(const ViewerOptions& options)
@@ -213,15 +216,15 @@ Viewer::Viewer(const ViewerOptions& options)
       camera_(options.scene.camera),
       settings_(options.params),
       scale_(options.scale) {
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfw().WindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfw().WindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfw().WindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   window_.reset(
-      glfwCreateWindow(options.width, options.height, "flatmarch view", nullptr, nullptr));
+      glfw().CreateWindow(options.width, options.height, "flatmarch view", nullptr, nullptr));
   if (!window_)
     throw Unavailable("the viewer cannot open a window with an OpenGL 4.5 core context: " +
                       last_glfw_error);
-  glfwMakeContextCurrent(window_.get());
+  glfw().MakeContextCurrent(window_.get());
   try {
     gl_ = gl::load(gl_proc);
   } catch (const std::exception& e) {
@@ -229,7 +232,7 @@ Viewer::Viewer(const ViewerOptions& options)
                       e.what());
   }
   // A script runs as fast as it draws; a person gets frames paced by the display.
-  glfwSwapInterval(options.scripted ? 0 : 1);
+  glfw().SwapInterval(options.scripted ? 0 : 1);
 
   present_ = gl::link_program(gl_, kPresentVertexShader, kPresentFragmentShader);
   inset_program_ = gl::link_program(gl_, kInsetVertexShader, kInsetFragmentShader);
@@ -246,27 +249,27 @@ Viewer::Viewer(const ViewerOptions& options)
   gl_.EnableVertexAttribArray(0);
   gl_.EnableVertexAttribArray(1);
 
-  glfwSetWindowUserPointer(window_.get(), this);
-  glfwSetKeyCallback(window_.get(), [](GLFWwindow* w, int key, int, int action, int) {
+  glfw().SetWindowUserPointer(window_.get(), this);
+  glfw().SetKeyCallback(window_.get(), [](GLFWwindow* w, int key, int, int action, int) {
     if (action != GLFW_REPEAT) viewer_of(w).real_key(key, action == GLFW_PRESS);
   });
-  glfwSetCursorPosCallback(
+  glfw().SetCursorPosCallback(
       window_.get(), [](GLFWwindow* w, double x, double y) { viewer_of(w).real_cursor(x, y); });
-  glfwSetMouseButtonCallback(window_.get(), [](GLFWwindow* w, int button, int action, int) {
+  glfw().SetMouseButtonCallback(window_.get(), [](GLFWwindow* w, int button, int action, int) {
     if (button == GLFW_MOUSE_BUTTON_LEFT && action == GLFW_PRESS) viewer_of(w).real_click();
   });
-  glfwSetWindowFocusCallback(window_.get(), [](GLFWwindow* w, int focused) {
+  glfw().SetWindowFocusCallback(window_.get(), [](GLFWwindow* w, int focused) {
     if (!focused) viewer_of(w).focus_lost();  // no key stays held while another window types
   });
-  if (!options.scripted && glfwRawMouseMotionSupported())
-    glfwSetInputMode(window_.get(), GLFW_RAW_MOUSE_MOTION, GLFW_TRUE);
+  if (!options.scripted && glfw().RawMouseMotionSupported())
+    glfw().SetInputMode(window_.get(), GLFW_RAW_MOUSE_MOTION, GLFW_TRUE);
   set_captured(true);
   if (const std::string e = gl::errors(gl_); !e.empty())
     throw std::runtime_error("the viewer failed to set up OpenGL: " + e);
 }
 
 Viewer::~Viewer() {
-  glfwMakeContextCurrent(window_.get());
+  glfw().MakeContextCurrent(window_.get());
   targets_.reset();
   programs_.clear();
   gl_.DeleteBuffers(1, &inset_buffer_);
@@ -280,8 +283,8 @@ void Viewer::set_captured(bool captured) {
   captured_ = captured;
   have_cursor_ = false;    // the next cursor position is a new start, not a motion
   if (!options_.scripted)  // a script's logical cursor leaves the real one alone
-    glfwSetInputMode(window_.get(), GLFW_CURSOR,
-                     captured ? GLFW_CURSOR_DISABLED : GLFW_CURSOR_NORMAL);
+    glfw().SetInputMode(window_.get(), GLFW_CURSOR,
+                        captured ? GLFW_CURSOR_DISABLED : GLFW_CURSOR_NORMAL);
 }
 
 void Viewer::key(int key, bool press) {
@@ -383,7 +386,7 @@ const gl::KernelProgram& Viewer::program() {
     std::rotate(it, it + 1, programs_.end());  // now the most recently used
     return *programs_.back().program;
   }
-  glfwSetWindowTitle(window_.get(), ("flatmarch view: " + scene_.name + " | compiling").c_str());
+  glfw().SetWindowTitle(window_.get(), ("flatmarch view: " + scene_.name + " | compiling").c_str());
   auto made =
       std::make_unique<gl::KernelProgram>(gl_, kernel::compile_scene<float>(scene_, params), false);
   if (programs_.size() == kMaxPrograms) programs_.erase(programs_.begin());
@@ -404,7 +407,7 @@ bool Viewer::frame(double dt) {
   if (move != Vec3(0.0)) camera_ = walk(scene_, camera_, move.x, move.y, move.z).camera;
 
   int width = 0, height = 0;
-  glfwGetFramebufferSize(window_.get(), &width, &height);
+  glfw().GetFramebufferSize(window_.get(), &width, &height);
   if (width <= 0 || height <= 0) return false;
   const int w = std::max(1, static_cast<int>(std::lround(width * scale_.value())));
   const int h = std::max(1, static_cast<int>(std::lround(height * scale_.value())));
@@ -427,7 +430,7 @@ bool Viewer::frame(double dt) {
   gl_.BindTexture(GL_TEXTURE_2D, targets_->colour());
   gl_.DrawArrays(GL_TRIANGLES, 0, 3);
   draw_inset(width, height);
-  glfwSwapBuffers(window_.get());
+  glfw().SwapBuffers(window_.get());
   if (const std::string e = gl::errors(gl_); !e.empty())
     throw std::runtime_error("the viewer failed to draw a frame: " + e);
   ++frames_;
@@ -476,14 +479,14 @@ void Viewer::update_title(double frame_ms) {
                 scene_.name.c_str(), camera_.polygon, to_string(p.method), p.eps, p.offset,
                 scale_.value(), targets_ ? targets_->width() : 0, targets_ ? targets_->height() : 0,
                 frame_ms, mean_steps());
-  glfwSetWindowTitle(window_.get(), text);
+  glfw().SetWindowTitle(window_.get(), text);
 }
 
 // The view at the window's full resolution, drawn by the same program and written by the PNG
 // writer of `flatmarch render` (output/image_io.hpp): the inset is not in it.
 void Viewer::screenshot(const std::filesystem::path& path) {
   int width = 0, height = 0;
-  glfwGetFramebufferSize(window_.get(), &width, &height);
+  glfw().GetFramebufferSize(window_.get(), &width, &height);
   if (width <= 0 || height <= 0) width = options_.width, height = options_.height;
   const gl::KernelProgram& kernel = program();
   Frame frame(width, height);
@@ -580,14 +583,14 @@ void Viewer::run() {
   size_t next_step = 0;
   int frames_left = 0, release = -1;
   // Frame times for the title and for the summary (frames that compiled a program aside).
-  double last = glfwGetTime(), title_at = last, title_ms = 0.0, total_ms = 0.0;
+  double last = glfw().GetTime(), title_at = last, title_ms = 0.0, total_ms = 0.0;
   int title_frames = 0, timed_frames = 0;
   // Ends when the window closes, Esc quits, the script ends or the frames are drawn; a script
   // runs a bounded number of frames.
   while (!quit_) {
-    glfwPollEvents();
+    glfw().PollEvents();
     if (pending_) std::rethrow_exception(pending_);
-    if (glfwWindowShouldClose(window_.get()) || quit_) break;
+    if (glfw().WindowShouldClose(window_.get()) || quit_) break;
     double dt = 0.0;
     if (options_.scripted) {
       // The script's steps up to the next one that takes frames (a hold or frames).
@@ -603,15 +606,15 @@ void Viewer::run() {
       --frames_left;
       dt = kScriptFrameTime;
     } else {
-      dt = std::min(glfwGetTime() - last, kMaxFrameTime);
+      dt = std::min(glfw().GetTime() - last, kMaxFrameTime);
     }
     compiled_ = false;
     if (!frame(dt)) {
-      glfwWaitEventsTimeout(0.1);  // minimised: nothing to draw, so wait rather than spin
-      last = glfwGetTime();
+      glfw().WaitEventsTimeout(0.1);  // minimised: nothing to draw, so wait rather than spin
+      last = glfw().GetTime();
       continue;
     }
-    const double now = glfwGetTime(), ms = 1000.0 * (now - last);
+    const double now = glfw().GetTime(), ms = 1000.0 * (now - last);
     last = now;
     if (!compiled_) title_ms += ms, ++title_frames, total_ms += ms, ++timed_frames;
     if (title_due_ || now - title_at >= kTitlePeriod) {

@@ -1,12 +1,10 @@
 #include "backends/opengl/opengl.hpp"
 
-#include <GL/osmesa.h>
-
 #include <algorithm>
-#include <map>
 #include <mutex>
 #include <stdexcept>
 
+#include "backends/opengl/context.hpp"
 #include "backends/opengl/gl_api.hpp"
 #include "backends/opengl/gl_kernel.hpp"
 #include "backends/process_exit.hpp"
@@ -22,26 +20,16 @@ constexpr int kBandRows = 64;
 // Compiled programs kept per context (a program is a scene, its march parameters and a variant).
 constexpr size_t kProgramCache = 16;
 
-void* osmesa_proc(const char* name) {
-  return reinterpret_cast<void*>(OSMesaGetProcAddress(name));
-}
-
 }  // namespace
 
 struct OpenGlBackend::Context {
-  OSMesaContext osmesa = nullptr;
-  std::vector<unsigned char> surface;  // OSMesa's own framebuffer: unused (we draw to FBOs)
-  gl::Api gl;
-  std::string renderer;
+  std::unique_ptr<gl::Context> gl_context;
   GLint max_size = 0;
-  std::mutex mutex;  // one frame or trace at a time; the context is made current per call
+  std::mutex mutex;  // one frame or trace at a time; the context is current only during one
   // Programs by their fragment source, least recently used first.
   std::vector<std::pair<std::string, std::unique_ptr<gl::KernelProgram>>> programs;
 
-  void make_current() {
-    if (!OSMesaMakeCurrent(osmesa, surface.data(), GL_UNSIGNED_BYTE, 1, 1))
-      throw std::runtime_error("the opengl backend cannot make its OSMesa context current");
-  }
+  const gl::Api& gl() const { return gl_context->api(); }
 
   gl::KernelProgram& program(const kernel::SceneTables<float>& tables, bool trace) {
     std::string key = kernel::scene_fragment_shader(tables, trace);
@@ -49,7 +37,8 @@ struct OpenGlBackend::Context {
                            [&](const auto& p) { return p.first == key; });
     if (it == programs.end()) {
       if (programs.size() == kProgramCache) programs.erase(programs.begin());
-      programs.emplace_back(std::move(key), std::make_unique<gl::KernelProgram>(gl, tables, trace));
+      programs.emplace_back(std::move(key),
+                            std::make_unique<gl::KernelProgram>(gl(), tables, trace));
       it = programs.end() - 1;
     } else {
       std::rotate(it, it + 1, programs.end());  // now the most recently used
@@ -59,15 +48,17 @@ struct OpenGlBackend::Context {
   }
 
   ~Context() {
-    if (osmesa != nullptr) {
-      make_current();
+    if (!gl_context) return;
+    try {
+      const gl::Context::Current current(*gl_context);
       programs.clear();
-      OSMesaDestroyContext(osmesa);
+    } catch (const std::exception&) {
+      // The context cannot be made current: its programs go with it.
     }
   }
 };
 
-OpenGlBackend::OpenGlBackend() = default;
+OpenGlBackend::OpenGlBackend(const BackendOptions& options) : options_(options) {}
 
 // The context is made on first use, not when the backend is listed: every command builds the
 // backend registry, and few draw.
@@ -78,36 +69,14 @@ OpenGlBackend::Context* OpenGlBackend::context() const {
 
 void OpenGlBackend::make_context() const {
   auto c = std::make_unique<Context>();
-  const int attributes[] = {OSMESA_FORMAT,
-                            OSMESA_RGBA,
-                            OSMESA_DEPTH_BITS,
-                            0,
-                            OSMESA_PROFILE,
-                            OSMESA_CORE_PROFILE,
-                            OSMESA_CONTEXT_MAJOR_VERSION,
-                            4,
-                            OSMESA_CONTEXT_MINOR_VERSION,
-                            5,
-                            0};
-  c->osmesa = OSMesaCreateContextAttribs(attributes, nullptr);
-  if (c->osmesa == nullptr) {
-    unavailable_ = "OSMesa cannot create an OpenGL 4.5 core context here";
-    return;
-  }
-  c->surface.assign(4, 0);
   try {
-    c->make_current();
-    c->gl = gl::load(osmesa_proc);
+    c->gl_context = gl::make_context(options_.device);
+    const gl::Context::Current current(*c->gl_context);
+    c->gl().GetIntegerv(GL_MAX_TEXTURE_SIZE, &c->max_size);
   } catch (const std::exception& e) {
     unavailable_ = e.what();
     return;
   }
-  const auto text = [&](GLenum what) {
-    const GLubyte* s = c->gl.GetString(what);
-    return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
-  };
-  c->renderer = text(GL_RENDERER) + ", " + text(GL_VERSION);
-  c->gl.GetIntegerv(GL_MAX_TEXTURE_SIZE, &c->max_size);
   context_ = std::move(c);
   driver_loaded();  // after the driver has made its context, threads and exit handlers
 }
@@ -123,9 +92,11 @@ namespace {
 }  // namespace
 
 std::string OpenGlBackend::description() const {
-  return "the kernel as an OpenGL fragment shader, specialised per scene, headless through "
-         "OSMesa (" +
-         (context() ? context_->renderer : std::string("unavailable")) + "); f32";
+  if (!context())
+    return "the kernel as an OpenGL fragment shader, specialised per scene (unavailable)";
+  const gl::Device& d = context_->gl_context->device();
+  return "the kernel as an OpenGL fragment shader, specialised per scene, headless (" + d.renderer +
+         ", " + d.version + ", " + d.platform + (d.software ? ", software" : "") + "); f32";
 }
 
 Availability OpenGlBackend::availability() const {
@@ -133,8 +104,25 @@ Availability OpenGlBackend::availability() const {
   return {};
 }
 
+std::optional<DeviceInfo> OpenGlBackend::device() const {
+  if (!context()) return std::nullopt;
+  const gl::Device& d = context_->gl_context->device();
+  return DeviceInfo{.name = d.renderer,
+                    .type = d.software ? "CPU" : "GPU",
+                    .api = "OpenGL " + d.version,
+                    .driver = d.driver(),
+                    .platform = d.platform,
+                    .software = d.software};
+}
+
 std::string OpenGlBackend::renderer() const {
-  return context() ? context_->renderer : "";
+  if (!context()) return "";
+  const gl::Device& d = context_->gl_context->device();
+  return d.renderer + ", " + d.version;
+}
+
+int OpenGlBackend::device_index() const {
+  return context() ? context_->gl_context->device().index : -1;
 }
 
 namespace {
@@ -157,8 +145,8 @@ Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width,
                                 " pixels a side here");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const std::lock_guard<std::mutex> lock(c.mutex);
-  c.make_current();
-  const gl::Api& gl = c.gl;
+  const gl::Context::Current current(*c.gl_context);
+  const gl::Api& gl = c.gl();
   gl.GetError();  // a clean slate for the check below
   gl::KernelProgram& program = c.program(tables, false);
   const gl::RenderTargets targets(gl, width, height);
@@ -201,9 +189,9 @@ Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width,
 void OpenGlBackend::compile(const std::string& fragment) const {
   if (!context()) unavailable(unavailable_);
   const std::lock_guard<std::mutex> lock(context_->mutex);
-  context_->make_current();
-  context_->gl.DeleteProgram(
-      gl::link_program(context_->gl, kernel::kFullScreenVertexShader, fragment));
+  const gl::Context::Current current(*context_->gl_context);
+  const gl::Api& gl = context_->gl();
+  gl.DeleteProgram(gl::link_program(gl, kernel::kFullScreenVertexShader, fragment));
 }
 
 Trace OpenGlBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params,
@@ -213,8 +201,8 @@ Trace OpenGlBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   Context& c = *context_;
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const std::lock_guard<std::mutex> lock(c.mutex);
-  c.make_current();
-  const gl::Api& gl = c.gl;
+  const gl::Context::Current current(*c.gl_context);
+  const gl::Api& gl = c.gl();
   gl.GetError();
   gl::KernelProgram& program = c.program(tables, true);
   const gl::RenderTargets targets(gl, 1, 1);

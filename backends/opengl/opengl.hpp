@@ -1,5 +1,6 @@
 // The OpenGL backend: the kernel as a fragment shader (kernels/scene_shader.hpp), specialised per
-// scene with its tables baked in, run headless through OSMesa (Mesa's llvmpipe on the CPU). Colour
+// scene with its tables baked in, run headless on the machine's GPU through EGL, or on the CPU
+// (Mesa's llvmpipe, through EGL or OSMesa) where it has none (backends/opengl/context.hpp). Colour
 // and the AOVs are two float render targets read back into the frame. Float32 only.
 #pragma once
 
@@ -14,7 +15,8 @@ namespace flatmarch {
 
 class OpenGlBackend final : public Backend {
  public:
-  OpenGlBackend();
+  // options.device picks the device (an index or a part of its name, as gl::list_devices()).
+  explicit OpenGlBackend(const BackendOptions& options = {});
   ~OpenGlBackend() override;
 
   std::string name() const override { return "opengl"; }
@@ -24,6 +26,7 @@ class OpenGlBackend final : public Backend {
     return {Method::sphere, Method::relaxed, Method::analytic};
   }
   std::vector<Precision> precisions() const override { return {Precision::f32}; }
+  std::optional<DeviceInfo> device() const override;
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;
   Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
@@ -35,12 +38,15 @@ class OpenGlBackend final : public Backend {
 
   // The OpenGL renderer and version of its context ("" when unavailable).
   std::string renderer() const;
+  // Its device's index in gl::list_devices(), or -1 when unavailable.
+  int device_index() const;
 
  private:
-  struct Context;            // the OSMesa context, its GL functions and compiled programs
+  struct Context;            // the context, its GL functions and compiled programs
   Context* context() const;  // null when unavailable (unavailable_ says why)
   void make_context() const;
 
+  BackendOptions options_;
   mutable std::once_flag made_;
   mutable std::unique_ptr<Context> context_;
   mutable std::string unavailable_;

@@ -167,7 +167,8 @@ struct VulkanBackend::Context {
   // host-visible and cached, else copied to `staging`) and the trace's events.
   Buffer pixels, staging, events;
   bool read_directly = false;
-  std::mutex mutex;  // one frame or trace at a time
+  bool force_staging = false;  // BackendOptions::vk_staging
+  std::mutex mutex;            // one frame or trace at a time
   // Pipelines by their source, least recently used first.
   std::vector<std::pair<std::string, vk::raii::Pipeline>> pipelines;
 
@@ -221,7 +222,9 @@ struct VulkanBackend::Context {
     staging = Buffer();
     // Read back directly where device memory is host-visible and cached (lavapipe, integrated
     // GPUs); reading uncached memory from the CPU is slow, so a discrete GPU copies to staging.
-    {
+    if (force_staging) {
+      read_directly = false;
+    } else {
       vk::raii::Buffer probe(device, vk::BufferCreateInfo({}, size, usage));
       read_directly = memory_type(probe.getMemoryRequirements().memoryTypeBits,
                                   vk::MemoryPropertyFlagBits::eDeviceLocal | host)
@@ -467,6 +470,7 @@ void VulkanBackend::make_context() const {
                        vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_size));
     c->set = std::move(vk::raii::DescriptorSets(
         c->device, vk::DescriptorSetAllocateInfo(*c->descriptor_pool, set_layout))[0]);
+    c->force_staging = options_.vk_staging;
     c->reserve_events(shader_trace_bytes(64));
     c->reserve_pixels(64 * 64 * kChannels * sizeof(float));
     context_ = std::move(c);
@@ -520,6 +524,22 @@ std::string VulkanBackend::description() const {
 Availability VulkanBackend::availability() const {
   if (!context()) return {false, unavailable_};
   return {};
+}
+
+std::optional<DeviceInfo> VulkanBackend::device() const {
+  if (!context()) return std::nullopt;
+  const vulkan::Device& d = context_->devices[static_cast<size_t>(context_->chosen)];
+  return DeviceInfo{
+      .name = d.name,
+      .type = d.type,
+      .api = "Vulkan " + d.api,
+      .driver = d.driver,
+      .platform = std::string("Vulkan") + (context_->read_directly ? "" : ", staging read-back"),
+      .software = d.type == "CPU"};
+}
+
+bool VulkanBackend::reads_through_staging() const {
+  return context() && !context_->read_directly;
 }
 
 std::vector<vulkan::Device> VulkanBackend::devices() const {

@@ -44,6 +44,7 @@ class VulkanBackend final : public Backend {
     return {Method::sphere, Method::relaxed, Method::analytic};
   }
   std::vector<Precision> precisions() const override { return {Precision::f32}; }
+  std::optional<DeviceInfo> device() const override;
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;
   Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
@@ -53,6 +54,9 @@ class VulkanBackend final : public Backend {
   std::vector<vulkan::Device> devices() const;
   // The device it runs on, or -1.
   int device_index() const;
+  // Whether frames come back through a staging copy (the device's memory is not host-visible,
+  // or BackendOptions::vk_staging asks for it).
+  bool reads_through_staging() const;
   // Whether it runs under the validation layer.
   bool validation() const { return validation_; }
 
