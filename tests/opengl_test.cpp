@@ -1,12 +1,15 @@
-// The OpenGL backend (headless, OSMesa): traces, image orientation, progress, errors, the
-// generated shader and its compile errors, and the command line (opengl_conformance_test holds
-// it against the oracle on the gallery). Skipped, visibly, when OSMesa cannot give an OpenGL 4.5
-// context here.
+// The OpenGL backend (headless, through EGL or OSMesa): traces, image orientation, progress,
+// errors, the generated shader and its compile errors, its devices, and the command line
+// (gallery_conformance_test holds it against the oracle on the gallery, device_paths_test holds
+// EGL and OSMesa to the same frames). Skipped, visibly, when no OpenGL 4.5 context can be made
+// here.
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <iostream>
 #include <map>
+
+#include <nlohmann/json.hpp>
 
 #include "backends/opengl/gl_kernel.hpp"
 #include "backends/opengl/opengl.hpp"
@@ -160,6 +163,106 @@ TEST(OpenGlCli, ShaderPrintsTheSourceAndCompileReportsErrorsWithExit2) {
   EXPECT_EQ(failed.exit_code, 2);
   EXPECT_NE(failed.err.find("error: " + file), std::string::npos) << failed.err;
   EXPECT_NE(failed.err.find("out_color = shade(r);"), std::string::npos) << failed.err;
+}
+
+std::string scene_path(const std::string& name) {
+  return std::string(FLATMARCH_SOURCE_DIR) + "/scenes/" + name + ".json";
+}
+
+// `flatmarch backends --json`'s opengl entry, run with `environment` (VAR=VALUE) set.
+nlohmann::json opengl_entry(const std::vector<std::string>& environment = {}) {
+  std::vector<std::string> argv = {"env"};
+  argv.insert(argv.end(), environment.begin(), environment.end());
+  argv.insert(argv.end(), {FLATMARCH_BINARY, "backends", "--json"});
+  const auto listed = test::run_process(argv);
+  EXPECT_EQ(listed.exit_code, 0) << listed.err;
+  for (const auto& b : nlohmann::json::parse(listed.out))
+    if (b["name"] == "opengl") return b;
+  ADD_FAILURE() << "no opengl backend listed";
+  return {};
+}
+
+TEST(OpenGlCli, BackendsListsTheDevicesOfEglAndOsMesaAndRenderRunsOnEach) {
+  SKIP_WITHOUT_OPENGL();
+  const nlohmann::json gl = opengl_entry();
+  ASSERT_TRUE(gl.contains("devices")) << gl;
+  bool egl = false, osmesa = false;
+  int defaults = 0;
+  const std::string dir = test::make_temp_dir();
+  for (const auto& d : gl["devices"]) {
+    const std::string platform = d["platform"].get<std::string>();
+    defaults += d["default"].get<bool>() ? 1 : 0;
+    if (!d["usable"].get<bool>()) {
+      EXPECT_FALSE(d["reason"].get<std::string>().empty()) << d;
+      continue;
+    }
+    egl = egl || platform.rfind("EGL", 0) == 0;
+    osmesa = osmesa || platform == "OSMesa";
+    EXPECT_FALSE(d["renderer"].get<std::string>().empty()) << d;
+    EXPECT_EQ(d["version"].get<std::string>().rfind("4.", 0), 0u) << d;
+    if (d["renderer"].get<std::string>().find("llvmpipe") != std::string::npos) {
+      EXPECT_TRUE(d["software"].get<bool>()) << d;
+    }
+    const std::string index = std::to_string(d["index"].get<int>());
+    const auto r = test::run_flatmarch({"render", scene_path("l_shape"), "--backend", "opengl",
+                                        "--device", index, "--method", "analytic", "--size",
+                                        "32x18", "-o", dir + "/" + index + ".png"});
+    EXPECT_EQ(r.exit_code, 0) << platform << ": " << r.err;
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + index + ".exr"));
+  }
+  EXPECT_EQ(defaults, 1) << gl;
+  EXPECT_TRUE(osmesa) << "OSMesa makes no context here: " << gl;
+  if (!egl) std::cout << "[ note     ] EGL makes no context here: " << gl["devices"] << "\n";
+  // The device that draws names itself beside the figures.
+  ASSERT_TRUE(gl.contains("device")) << gl;
+  EXPECT_FALSE(gl["device"]["driver"].get<std::string>().empty()) << gl;
+}
+
+TEST(OpenGlCli, AnUnknownDeviceExits3AndListsTheDevices) {
+  SKIP_WITHOUT_OPENGL();
+  const auto r =
+      test::run_flatmarch({"render", scene_path("torus"), "--backend", "opengl", "--device",
+                           "no such device", "-o", test::make_temp_dir() + "/x.png"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("no OpenGL device matches --device \"no such device\" (devices: 0 "),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("(OSMesa)"), std::string::npos) << r.err;
+}
+
+TEST(OpenGlCli, WithoutAnEglDriverOsMesaDrawsAndEglSaysWhy) {
+  SKIP_WITHOUT_OPENGL();
+  // libglvnd's EGL reads its vendors from this variable when set: here, none.
+  const std::string no_vendor = "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl_vendor.json";
+  const nlohmann::json gl = opengl_entry({no_vendor});
+  ASSERT_TRUE(gl["available"].get<bool>()) << gl;
+  EXPECT_EQ(gl["device"]["platform"], "OSMesa") << gl;
+  ASSERT_FALSE(gl["devices"].empty());
+  EXPECT_FALSE(gl["devices"][0]["usable"].get<bool>());
+  EXPECT_NE(gl["devices"][0]["reason"].get<std::string>().find("EGL finds no driver"),
+            std::string::npos)
+      << gl;
+  const std::string dir = test::make_temp_dir();
+  const auto r =
+      test::run_process({"env", no_vendor, FLATMARCH_BINARY, "render", scene_path("torus"),
+                         "--backend", "opengl", "--size", "16x9", "-o", dir + "/t.png"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST(OpenGlCli, WhereNoDeviceGivesOpenGl45TheBackendIsUnavailableExit3AndSaysWhy) {
+  SKIP_WITHOUT_OPENGL();
+  // Mesa's softpipe rasteriser has no OpenGL 4.5: neither EGL nor OSMesa can make the context.
+  const std::vector<std::string> softpipe = {"GALLIUM_DRIVER=softpipe"};
+  const nlohmann::json gl = opengl_entry(softpipe);
+  EXPECT_FALSE(gl["available"].get<bool>()) << gl;
+  EXPECT_NE(gl["reason"].get<std::string>().find("no OpenGL 4.5 core context can be made"),
+            std::string::npos)
+      << gl;
+  const auto r = test::run_process({"env", softpipe[0], FLATMARCH_BINARY, "render",
+                                    scene_path("torus"), "--backend", "opengl", "--size", "16x9",
+                                    "-o", test::make_temp_dir() + "/t.png"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("backend opengl is unavailable here"), std::string::npos) << r.err;
 }
 
 }  // namespace

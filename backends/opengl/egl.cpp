@@ -50,11 +50,20 @@ struct Egl {
   static std::string text(const char* s) {
     return s ? s : "";
   }
-  // "EGL error 0x3001" for the last error.
+  // The last error, by its name in the EGL specification.
   std::string error() const {
-    char code[32];
-    std::snprintf(code, sizeof code, "EGL error 0x%04x", static_cast<unsigned>(eglGetError()));
-    return code;
+    static constexpr const char* kNames[] = {
+        "EGL_NOT_INITIALIZED",     "EGL_BAD_ACCESS",        "EGL_BAD_ALLOC",
+        "EGL_BAD_ATTRIBUTE",       "EGL_BAD_CONFIG",        "EGL_BAD_CONTEXT",
+        "EGL_BAD_CURRENT_SURFACE", "EGL_BAD_DISPLAY",       "EGL_BAD_MATCH",
+        "EGL_BAD_NATIVE_PIXMAP",   "EGL_BAD_NATIVE_WINDOW", "EGL_BAD_PARAMETER",
+        "EGL_BAD_SURFACE",         "EGL_CONTEXT_LOST"};
+    const EGLint code = eglGetError();
+    if (code >= EGL_NOT_INITIALIZED && code <= EGL_CONTEXT_LOST)
+      return kNames[code - EGL_NOT_INITIALIZED];
+    char text[32];
+    std::snprintf(text, sizeof text, "EGL error 0x%04x", static_cast<unsigned>(code));
+    return text;
   }
 };
 
@@ -213,8 +222,11 @@ std::vector<Candidate> egl_candidates() {
     found.push_back(std::move(c));
   }
   if (found.empty())
-    return {unusable("EGL lists no device and has no surfaceless platform (client extensions: " +
-                     e->client_extensions + ")")};
+    return {unusable(e->client_extensions.empty()
+                         ? "EGL finds no driver (Debian: libegl-mesa0, or a GPU driver's EGL)"
+                         : "EGL lists no device and has no surfaceless platform (its client "
+                           "extensions: " +
+                               e->client_extensions + ")")};
   return found;
 }
 
