@@ -1,0 +1,80 @@
+// A command loads only the libraries it uses: the flatmarch program links no GPU, windowing or
+// image library, and commands that draw or write nothing do not open one at run time either
+// (bench/startup_bench times what that saves).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/process.hpp"
+
+namespace flatmarch {
+namespace {
+
+// Libraries only some commands need, as the dynamic loader names their files.
+const std::vector<std::string> kHeavy = {"libOpenImageIO", "libOSMesa", "libEGL",
+                                         "libGL.",         "libGLX",    "libvulkan",
+                                         "libglfw",        "libX11",    "libLLVM"};
+
+std::string scene(const std::string& name) {
+  return std::string(FLATMARCH_SOURCE_DIR) + "/scenes/" + name + ".json";
+}
+
+// The files the dynamic loader opened while running `flatmarch ARGS` (LD_DEBUG=files); the
+// command is expected to exit with `exit_code`.
+std::string loaded_by(const std::vector<std::string>& args, int exit_code = 0) {
+  std::vector<std::string> argv = {"env", "LD_DEBUG=files", FLATMARCH_BINARY};
+  argv.insert(argv.end(), args.begin(), args.end());
+  const test::ProcessResult r = test::run_process(argv);
+  EXPECT_EQ(r.exit_code, exit_code) << r.err.substr(r.err.size() > 2000 ? r.err.size() - 2000 : 0);
+  std::string files;
+  for (size_t at = r.err.find("file="); at != std::string::npos; at = r.err.find("file=", at + 1))
+    files += r.err.substr(at, r.err.find_first_of(" \n", at) - at) + "\n";
+  return files;
+}
+
+TEST(Startup, TheProgramLinksNoGpuWindowOrImageLibrary) {
+  const test::ProcessResult r = test::run_process({"ldd", FLATMARCH_BINARY});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const std::string& name : kHeavy)
+    EXPECT_EQ(r.out.find(name), std::string::npos) << name << " is linked:\n" << r.out;
+}
+
+TEST(Startup, CommandsThatDrawAndWriteNothingOpenNoneOfThem) {
+  const std::string dir = test::make_temp_dir();
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--help"},
+        {"inspect", scene("torus")},
+        {"trace", scene("torus"), "--from", "1,1,1", "--dir", "3,1,0"},
+        {"plan", scene("l_shape"), "-o", dir + "/l.svg"}}) {
+    const std::string files = loaded_by(args);
+    ASSERT_FALSE(files.empty()) << "LD_DEBUG=files printed nothing for " << args[0];
+    for (const std::string& name : kHeavy)
+      EXPECT_EQ(files.find(name), std::string::npos) << args[0] << " opens " << name;
+  }
+}
+
+TEST(Startup, AnImageWrittenLoadsOpenImageIoAndADrawingLoadsItsDriver) {
+  const std::string dir = test::make_temp_dir();
+  const std::string simd = loaded_by(
+      {"render", scene("torus"), "--backend", "simd", "--size", "16x9", "-o", dir + "/t.png"});
+  EXPECT_NE(simd.find("libOpenImageIO"), std::string::npos) << simd;
+  for (const char* name : {"libEGL", "libOSMesa", "libvulkan", "libglfw"})
+    EXPECT_EQ(simd.find(name), std::string::npos) << "a simd render opens " << name;
+  // Exit 3 where no OpenGL context can be made: the drivers are opened to find that out.
+  bool drawn = false;
+  for (const auto& b : nlohmann::json::parse(test::run_flatmarch({"backends", "--json"}).out))
+    if (b["name"] == "opengl") drawn = b["available"].get<bool>();
+  const std::string opengl = loaded_by(
+      {"render", scene("torus"), "--backend", "opengl", "--size", "16x9", "-o", dir + "/g.png"},
+      drawn ? 0 : 3);
+  EXPECT_TRUE(opengl.find("libEGL") != std::string::npos ||
+              opengl.find("libOSMesa") != std::string::npos)
+      << opengl;
+  EXPECT_EQ(opengl.find("libvulkan"), std::string::npos) << "an opengl render opens libvulkan";
+}
+
+}  // namespace
+}  // namespace flatmarch
