@@ -53,17 +53,25 @@ nlohmann::json hardware_fingerprint() {
                {"isa", simd.availability().available ? simd.isa() : "none"},
                {"simd_lanes", simd.lanes()},
                {"isas", simd::isa_names(true)}};
+  // The devices the GPU backends choose by default (a report run with --device says its own in
+  // each case).
   const OpenGlBackend opengl;
-  const Availability gl = opengl.availability();
-  fp["opengl"] = gl.available ? nlohmann::json{{"renderer", opengl.renderer()}}
-                              : nlohmann::json{{"unavailable", gl.reason}};
+  if (const std::optional<DeviceInfo> d = opengl.device())
+    fp["opengl"] = {
+        {"renderer", opengl.renderer()}, {"device", d->name},       {"api", d->api},
+        {"driver", d->driver},           {"platform", d->platform}, {"software", d->software}};
+  else
+    fp["opengl"] = {{"unavailable", opengl.availability().reason}};
   const VulkanBackend vulkan;
-  if (const Availability vk = vulkan.availability(); !vk.available) {
-    fp["vulkan"] = {{"unavailable", vk.reason}};
+  if (const std::optional<DeviceInfo> d = vulkan.device()) {
+    const vulkan::Device& listed = vulkan.devices().at(static_cast<size_t>(vulkan.device_index()));
+    fp["vulkan"] = {{"device", d->name},
+                    {"type", d->type},
+                    {"api", listed.api},
+                    {"driver", d->driver},
+                    {"software", d->software}};
   } else {
-    const std::vector<vulkan::Device> devices = vulkan.devices();
-    const vulkan::Device& d = devices.at(static_cast<size_t>(vulkan.device_index()));
-    fp["vulkan"] = {{"device", d.name}, {"type", d.type}, {"api", d.api}, {"driver", d.driver}};
+    fp["vulkan"] = {{"unavailable", vulkan.availability().reason}};
   }
   utsname os{};
   if (uname(&os) == 0) {
@@ -88,10 +96,14 @@ std::string describe_machine(const nlohmann::json& fp) {
   std::string s = fp["cpu"]["model"].get<std::string>() + ", " +
                   std::to_string(fp["cpu"]["logical_cores"].get<int>()) + " threads, " +
                   fp["cpu"]["isa"].get<std::string>();
+  // Results written before devices carried the software flag have none.
+  const auto software = [](const nlohmann::json& d) {
+    return d.value("software", false) ? " (software)" : "";
+  };
   if (fp["vulkan"].contains("device"))
-    s += "; Vulkan: " + fp["vulkan"]["device"].get<std::string>();
+    s += "; Vulkan: " + fp["vulkan"]["device"].get<std::string>() + software(fp["vulkan"]);
   if (fp["opengl"].contains("renderer"))
-    s += "; OpenGL: " + fp["opengl"]["renderer"].get<std::string>();
+    s += "; OpenGL: " + fp["opengl"]["renderer"].get<std::string>() + software(fp["opengl"]);
   return s;
 }
 

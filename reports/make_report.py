@@ -70,6 +70,14 @@ def pct(share):
     return f"{100 * share:.3g}%"
 
 
+def device_text(backend):
+    """Where a ranked backend ran: its GPU-backend device (marked when software), or the CPU."""
+    d = backend.get("device")
+    if not d:
+        return "CPU"
+    return d["name"] + (" (software)" if d.get("software") else "") + (f', {d["driver"]}' if d.get("driver") else "")
+
+
 def fingerprint_rows(fp):
     cpu = fp.get("cpu", {})
     rows = [
@@ -77,9 +85,12 @@ def fingerprint_rows(fp):
         ("SIMD", f'{cpu.get("isa", "?")} ({cpu.get("simd_lanes", "?")} lanes); compiled in: {", ".join(cpu.get("isas", []))}'),
     ]
     gl = fp.get("opengl", {})
-    rows.append(("OpenGL", gl.get("renderer", "unavailable: " + gl.get("unavailable", "?"))))
+    rows.append(("OpenGL", (f'{gl["renderer"]}' + (f' through {gl["platform"]}' if "platform" in gl else "") +
+                            (", software: a rasteriser on the CPU" if gl.get("software") else ""))
+                 if "renderer" in gl else "unavailable: " + gl.get("unavailable", "?")))
     vk = fp.get("vulkan", {})
-    rows.append(("Vulkan", f'{vk["device"]} ({vk.get("type")}, Vulkan {vk.get("api")}, driver {vk.get("driver")})'
+    rows.append(("Vulkan", f'{vk["device"]} ({vk.get("type")}, Vulkan {vk.get("api")}, driver {vk.get("driver")}'
+                 + (", software: a rasteriser on the CPU" if vk.get("software") else "") + ")"
                  if "device" in vk else "unavailable: " + vk.get("unavailable", "?")))
     rows.append(("OS", f'{fp.get("os", "?")} on {fp.get("host", "?")}'))
     rows.append(("Libraries", ", ".join(f"{k} {v}" for k, v in fp.get("libraries", {}).items())))
@@ -110,7 +121,7 @@ def ranking_section(results):
     methods = ["sphere", "relaxed", "analytic"]
     rows = []
     for b in results.get("ranking", []):
-        row = [b["rank"], b["backend"], mrays(b["rays_per_s"]),
+        row = [b["rank"], b["backend"], device_text(b), mrays(b["rays_per_s"]),
                f'{b["passed"]}/{b["cases"]}' + (f' ({b["errors"]} errors)' if b["errors"] else "")]
         for m in methods:
             mm = b["methods"].get(m)
@@ -118,8 +129,10 @@ def ranking_section(results):
         row.append(b["best_method"] or "-")
         rows.append(row)
     parts.append("<p>Backends ranked: those that passed every conformance case first, then by the geometric "
-                 "mean of rays per second over every scene and method. Per method: Mrays/s (cases passed).</p>")
-    parts.append(table(["rank", "backend", "Mrays/s", "conform"] + [f"{m} Mrays/s" for m in methods] +
+                 "mean of rays per second over every scene and method. Per method: Mrays/s (cases passed). "
+                 "A GPU backend names the device it ran on; <i>software</i> marks a rasteriser running on the "
+                 "CPU (Mesa's llvmpipe and lavapipe), whose speed says nothing of a GPU's.</p>")
+    parts.append(table(["rank", "backend", "device", "Mrays/s", "conform"] + [f"{m} Mrays/s" for m in methods] +
                        ["fastest conforming method"], rows))
     skipped = results.get("matrix", {}).get("skipped", [])
     if skipped:
@@ -422,6 +435,16 @@ def one_machine(results, images):
 # --- Machines compared.
 
 
+def gpu_text(fp):
+    """The machine's GPU, as its GPU backends found one: ", GPU NAME", or "" without one."""
+    for api in ("vulkan", "opengl"):
+        d = fp.get(api, {})
+        name = d.get("device") or d.get("renderer")
+        if name and "software" in d and not d["software"]:
+            return f", GPU {name}"
+    return ""
+
+
 def machines(all_results, names):
     body = ["<h1>flatmarch: machines compared</h1>"]
     fps = [r["fingerprint"] for r in all_results]
@@ -430,39 +453,56 @@ def machines(all_results, names):
         rows.append([label] + [fingerprint_rows(fp)[k][1] for fp in fps])
     body.append(table(["", *names], rows))
     backends = sorted({b["backend"] for r in all_results for b in r.get("ranking", [])})
-    fig, ax = plt.subplots(figsize=(2 + 1.6 * len(backends), 4))
+    fig, ax = plt.subplots(figsize=(2 + 1.6 * len(backends), 4.5))
     width = 0.8 / len(all_results)
     for i, (r, name) in enumerate(zip(all_results, names)):
-        speed = {b["backend"]: b["rays_per_s"] / 1e6 for b in r.get("ranking", [])}
-        ax.bar([k + i * width for k in range(len(backends))], [speed.get(b, 0) for b in backends], width,
-               label=name)
+        ranked = {b["backend"]: b for b in r.get("ranking", [])}
+        # A backend a machine did not measure gets no bar (not a zero, which a log axis cannot draw).
+        xs = [k + i * width for k, b in enumerate(backends) if ranked.get(b, {}).get("rays_per_s")]
+        ys = [ranked[b]["rays_per_s"] / 1e6 for b in backends if ranked.get(b, {}).get("rays_per_s")]
+        bars = ax.bar(xs, ys, width, label=name)
+        # Each GPU backend's bar names its device: the same backend is a GPU on one machine and
+        # a software rasteriser on another.
+        for bar, b in zip(bars, [b for b in backends if ranked.get(b, {}).get("rays_per_s")]):
+            d = ranked[b].get("device")
+            if d:
+                ax.annotate(d["name"].split(" (")[0][:24] + (" (sw)" if d.get("software") else ""),
+                            (bar.get_x() + bar.get_width() / 2, bar.get_height()), rotation=90, fontsize=6,
+                            ha="center", va="bottom", xytext=(0, 2), textcoords="offset points")
     ax.set_xticks([k + 0.4 - width / 2 for k in range(len(backends))], backends)
     ax.set_ylabel("Mrays/s, geometric mean over the gallery")
     ax.set_yscale("log")
-    ax.legend(fontsize=8)
+    bottom, top = ax.get_ylim()
+    ax.set_ylim(bottom, top * 30)  # room for the device names above the bars
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=1)
     ax.grid(True, axis="y", which="both", alpha=0.3)
     body.append("<h2>Speed per backend</h2>" + figure_html(fig, "speed per machine"))
     rows = []
     for r, name in zip(all_results, names):
         rec = r.get("recommendation", {})
-        order = ", ".join(f'{b["rank"]}. {b["backend"]} ({mrays(b["rays_per_s"])}, {b["passed"]}/{b["cases"]})'
-                          for b in r.get("ranking", []))
+        order = ", ".join(f'{b["rank"]}. {b["backend"]} on {device_text(b)} ({mrays(b["rays_per_s"])}, '
+                          f'{b["passed"]}/{b["cases"]})' for b in r.get("ranking", []))
         rows.append([name, f'{rec.get("backend")} / {rec.get("method")}', order])
     body.append("<h2>Rankings</h2>" + table(["machine", "choice", "ranking (Mrays/s, cases conforming)"], rows))
     base = {c["name"]: c for c in all_results[0].get("matrix", {}).get("cases", []) if "time_ms" in c}
+    base_devices = {b["backend"]: device_text(b) for b in all_results[0].get("ranking", [])}
     rows = []
     for r, name in zip(all_results[1:], names[1:]):
         ratios = {}
         for c in r.get("matrix", {}).get("cases", []):
             if c["name"] in base and "time_ms" in c:
                 ratios.setdefault(c["backend"], []).append(base[c["name"]]["time_ms"] / c["time_ms"])
+        devices = {b["backend"]: device_text(b) for b in r.get("ranking", [])}
         for b, v in sorted(ratios.items()):
             g = math.exp(sum(math.log(x) for x in v) / len(v))
-            rows.append([name, b, len(v), f"{g:.3g}x", f"{min(v):.3g}x", f"{max(v):.3g}x"])
+            rows.append([name, b, base_devices.get(b, "?"), devices.get(b, "?"), len(v), f"{g:.3g}x",
+                         f"{min(v):.3g}x", f"{max(v):.3g}x"])
     if rows:
         body.append(f"<h2>Speed-up over {esc(names[0])}</h2><p>Per backend, over the cases both measured: the "
                     "geometric mean, least and greatest ratio of frame times (above 1: faster than the first "
-                    "machine).</p>" + table(["machine", "backend", "cases", "geometric mean", "least", "greatest"], rows))
+                    "machine), with the device each machine's backend ran on.</p>" +
+                    table(["machine", "backend", "device there", "device here", "cases", "geometric mean",
+                           "least", "greatest"], rows))
     return PAGE.format(title="flatmarch: machines compared", body="\n".join(body))
 
 
@@ -481,7 +521,8 @@ def main():
         page = one_machine(all_results[0], images)
     else:
         names = [f'{os.path.basename(os.path.dirname(os.path.abspath(p))) or p}: '
-                 f'{r["fingerprint"]["cpu"]["model"]}' for p, r in zip(args.results, all_results)]
+                 f'{r["fingerprint"]["cpu"]["model"]}{gpu_text(r["fingerprint"])}'
+                 for p, r in zip(args.results, all_results)]
         page = machines(all_results, names)
     with open(os.path.join(args.out, "index.html"), "w") as f:
         f.write(page)

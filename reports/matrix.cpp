@@ -46,6 +46,16 @@ json accuracy_summary(const conformance::CaseResult& r) {
           {"failed", failed}};
 }
 
+json device_json(const DeviceInfo& d) {
+  return {{"name", d.name},     {"type", d.type},         {"api", d.api},
+          {"driver", d.driver}, {"platform", d.platform}, {"software", d.software}};
+}
+
+std::string device_label(const DeviceInfo& d) {
+  return "device " + d.name + "; driver " + d.driver + "; " + d.platform +
+         (d.software ? "; software" : "");
+}
+
 std::string case_name(const std::string& backend, Method method, const std::string& scene,
                       int width, int height) {
   return backend + "/" + to_string(method) + "/" + scene + "/" + std::to_string(width) + "x" +
@@ -80,14 +90,17 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                               const MarchParams& params, int width, int height, int repetitions,
                               double min_time, Frame* last, const std::string& name) {
   const auto* simd = dynamic_cast<const SimdBackend*>(&backend);
+  const std::optional<DeviceInfo> device = backend.device();
+  const std::string label = device ? device_label(*device) : "";
   auto warmed = std::make_shared<bool>(false);
   benchmark::internal::Benchmark* b =
       benchmark::RegisterBenchmark(
           (name.empty() ? case_name(backend.name(), params.method, scene.name, width, height)
                         : name)
               .c_str(),
-          [&backend, &scene, camera, params, width, height, last, simd,
-           warmed](benchmark::State& state) {
+          [&backend, &scene, camera, params, width, height, last, simd, warmed,
+           label](benchmark::State& state) {
+            if (!label.empty()) state.SetLabel(label);
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
             Frame f;
             try {
@@ -219,6 +232,8 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
              {"scene", scene.name},    {"surface_type", surface_type(scene)},
              {"method", to_string(m)}, {"width", o.width},
              {"height", o.height}};
+        if (const std::optional<DeviceInfo> device = backend->device())
+          c["device"] = device_json(*device);
         if (o.timing) {
           Frame* keep = nullptr;
           if (!o.images.empty() && m == o.methods.front()) keep = &frames[name];

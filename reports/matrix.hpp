@@ -42,8 +42,14 @@ using MatrixProgress = std::function<void(const std::string& line, int done, int
 // failed_checks (a line each) and failed (the names of the failed checks).
 nlohmann::json accuracy_summary(const conformance::CaseResult& r);
 
-// Runs the matrix. Returns {"benchmarks": Google Benchmark's JSON document, "cases": one per
-// backend x scene x method with its timing (median and samples, ms), counters and accuracy,
+// A GPU backend's device as results carry it: name, type, api, driver, platform, software.
+nlohmann::json device_json(const DeviceInfo& device);
+// The same in one line, as benchmark runs are labelled: "device NAME; driver DRIVER; software".
+std::string device_label(const DeviceInfo& device);
+
+// Runs the matrix. Returns {"benchmarks": Google Benchmark's JSON document (each GPU case's run
+// labelled with its device), "cases": one per backend x scene x method with its timing (median
+// and samples, ms), counters, accuracy and, for a GPU backend, the device it ran on (device_json),
 // "skipped": backends unavailable here with the reason}.
 nlohmann::json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& options,
                           conformance::Suite& suite, const MatrixProgress& progress);
@@ -55,7 +61,8 @@ nlohmann::json run_registered_benchmarks(const std::function<void(const std::str
 
 // Registers one timed case, BACKEND/METHOD/SCENE/WxH: frames of the scene's camera, after one
 // untimed frame (GPU backends compile the scene's program then); counters rays_per_s,
-// steps_mean, steps_p99, crossings_mean, out_of_steps and, for the SIMD backend, lane_utilisation.
+// steps_mean, steps_p99, crossings_mean, out_of_steps and, for the SIMD backend, lane_utilisation;
+// a GPU backend's runs are labelled with its device (device_label).
 // `last`, when given, receives the last frame. Repetitions and min_time of 0 leave them to
 // Google Benchmark's flags (--benchmark_repetitions, --benchmark_min_time).
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,

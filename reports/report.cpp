@@ -92,10 +92,12 @@ json rank_backends(const json& matrix) {
     std::map<std::string, std::array<double, 4>> methods;  // cases, passed, log rays, timed
   };
   std::map<std::string, Tally> tallies;
+  std::map<std::string, json> devices;  // of the GPU backends
   std::vector<std::string> order;
   for (const json& c : matrix.value("cases", json::array())) {
     const std::string b = c["backend"];
     if (!tallies.count(b)) order.push_back(b);
+    if (c.contains("device")) devices[b] = c["device"];
     Tally& t = tallies[b];
     auto& m = t.methods[c["method"].get<std::string>()];
     ++t.cases;
@@ -139,6 +141,10 @@ json rank_backends(const json& matrix) {
                        {"rays_per_s", t.timed ? std::exp(t.log_rays / t.timed) : 0.0},
                        {"methods", methods},
                        {"best_method", best.empty() ? json(nullptr) : json(best)}});
+    if (devices.count(b)) {
+      ranking.back()["device"] = devices[b];
+      ranking.back()["software"] = devices[b].value("software", false);
+    }
   }
   std::stable_sort(ranking.begin(), ranking.end(), [](const json& a, const json& b) {
     const bool ca = a["passed"] == a["cases"], cb = b["passed"] == b["cases"];
@@ -218,12 +224,16 @@ std::string describe_selection(const json& results, const std::string& type) {
   s += "ranking:\n";
   for (const json& b : results.at("ranking")) {
     std::snprintf(
-        line, sizeof line, "  %zu. %-7s %8.3g Mrays/s  %d/%d cases conform%s\n",
+        line, sizeof line, "  %zu. %-7s %8.3g Mrays/s  %d/%d cases conform%s",
         b["rank"].get<size_t>(), b["backend"].get<std::string>().c_str(),
         b["rays_per_s"].get<double>() / 1e6, b["passed"].get<int>(), b["cases"].get<int>(),
         b["errors"].get<int>() ? (", " + std::to_string(b["errors"].get<int>()) + " errors").c_str()
                                : "");
     s += line;
+    if (b.contains("device"))
+      s += "  on " + b["device"]["name"].get<std::string>() +
+           (b["device"]["software"].get<bool>() ? " (software: a rasteriser on the CPU)" : "");
+    s += "\n";
   }
   return s;
 }

@@ -312,11 +312,80 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   const std::string text2((std::istreambuf_iterator<char>(html2)),
                           std::istreambuf_iterator<char>());
   EXPECT_NE(text2.find("machines compared"), std::string::npos);
-  EXPECT_NE(text2.find("<td>scalar</td><td>1</td>"), std::string::npos);  // one common case
+  // One common case, on the CPU on both machines.
+  EXPECT_NE(text2.find("<td>scalar</td><td>CPU</td><td>CPU</td><td>1</td>"), std::string::npos);
 
   const auto bad = test::run_flatmarch({"select", dir + "/nothing.json"});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("run `flatmarch report` first"), std::string::npos);
+}
+
+TEST(ReportCommand, EveryGpuFigureNamesItsDeviceAndWhetherItIsSoftware) {
+  const std::string dir = test::make_temp_dir();
+  const std::string torus = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
+  const auto r = test::run_flatmarch(
+      {"report",       "--scene",       torus,      "--backend",  "opengl", "--backend",
+       "vulkan",       "--method",      "analytic", "--size",     "32x18",  "--conform-size",
+       "32x18",        "--repetitions", "2",        "--min-time", "0.001",  "--no-sweep",
+       "--no-scaling", "--no-html",     "-q",       "-o",         dir},
+      300);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(dir + "/results.json");
+  json results = json::parse(in);
+  if (results["matrix"]["cases"].empty())
+    GTEST_SKIP() << "no GPU backend is available here: " << results["matrix"]["skipped"];
+  for (const json& c : results["matrix"]["cases"]) {
+    ASSERT_TRUE(c.contains("device")) << c;
+    EXPECT_FALSE(c["device"]["name"].get<std::string>().empty()) << c;
+    EXPECT_FALSE(c["device"]["driver"].get<std::string>().empty()) << c;
+    // This machine has no GPU: Mesa's rasterisers on the CPU, and the figures say so.
+    if (c["device"]["name"].get<std::string>().find("llvmpipe") != std::string::npos) {
+      EXPECT_TRUE(c["device"]["software"].get<bool>()) << c;
+    }
+  }
+  for (const json& run : results["matrix"]["benchmarks"]["benchmarks"]) {
+    const std::string label = run.value("label", "");
+    EXPECT_EQ(label.rfind("device ", 0), 0u) << run;
+    EXPECT_NE(label.find("; driver "), std::string::npos) << run;
+  }
+  for (const json& b : results["ranking"]) {
+    ASSERT_TRUE(b.contains("device")) << b;
+    EXPECT_EQ(b["software"], b["device"]["software"]);
+  }
+  for (const char* api : {"opengl", "vulkan"})
+    if (!results["fingerprint"][api].contains("unavailable")) {
+      EXPECT_TRUE(results["fingerprint"][api].contains("software")) << results["fingerprint"];
+    }
+
+  // The same results as a GPU machine would write them, beside this one's: the comparison names
+  // each machine's device for the same backend.
+  json gpu = results;
+  gpu["fingerprint"]["cpu"]["model"] = "a GPU machine's CPU";
+  const json device = {{"name", "Test GPU 9000"},  {"type", "GPU"},
+                       {"api", "OpenGL 4.6"},      {"driver", "Test 1.0"},
+                       {"platform", "EGL device"}, {"software", false}};
+  for (json& c : gpu["matrix"]["cases"]) {
+    c["device"] = device;
+    c["time_ms"] = c["time_ms"].get<double>() / 50.0;
+  }
+  for (json& b : gpu["ranking"]) {
+    b["device"] = device;
+    b["software"] = false;
+  }
+  fs::create_directories(dir + "/gpu");
+  std::ofstream(dir + "/gpu/results.json") << gpu.dump();
+  const auto compare = test::run_flatmarch(
+      {"report", dir + "/results.json", dir + "/gpu/results.json", "-o", dir + "/compare"});
+  ASSERT_EQ(compare.exit_code, 0) << compare.err;
+  std::ifstream html(dir + "/compare/index.html");
+  const std::string text((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
+  const std::string here = results["ranking"][0]["backend"].get<std::string>();
+  EXPECT_NE(text.find("<td>" + here + "</td><td>" +
+                      results["ranking"][0]["device"]["name"].get<std::string>() + " (software)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("</td><td>Test GPU 9000, Test 1.0</td>"), std::string::npos);
+  EXPECT_NE(text.find("<td>50x</td>"), std::string::npos);
 }
 
 TEST(SweepCommand, FindsTheDefaultsStableAndAHugeEpsNot) {
