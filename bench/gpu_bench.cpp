@@ -1,33 +1,51 @@
-// The GPU backends, OpenGL (OSMesa) and Vulkan (any device; here lavapipe), side by side: every
-// gallery scene and method at 640x360 and 1920x1080 (BACKEND/METHOD/SCENE/WIDTHxHEIGHT), and the
-// original web app's benchmark views at 640x360 (peer/BACKEND/SCENE/METHOD), where each case also
-// reports its speed-up over the app's own shader as measured on this machine kind.
+// The GPU backends, OpenGL (through EGL or OSMesa) and Vulkan (any device; here lavapipe), side
+// by side: every gallery scene and method at 640x360 and 1920x1080 (BACKEND/METHOD/SCENE/WxH),
+// and the original web app's benchmark views at 640x360 (peer/BACKEND/SCENE/METHOD). Given the
+// app's shaders (--peer-shaders=DIR, regenerated as ../shared/peer-shaders.md says; or the
+// environment's FLATMARCH_PEER_SHADERS), each view is also drawn by the app's own shader on the
+// same OpenGL device (peer/app/SCENE), and every case of that view reports its speed-up over it
+// as measured in this run (speedup_vs_app; app_ms, the app's median).
 //
-//   build/bench/gpu_bench --benchmark_filter=peer/opengl/ --benchmark_repetitions=11
-//       --benchmark_report_aggregates_only=true
+//   build/bench/gpu_bench --peer-shaders=DIR --benchmark_filter=peer/
+//       --benchmark_repetitions=11 --benchmark_report_aggregates_only=true
 //   build/bench/gpu_bench --benchmark_filter='^(opengl|vulkan)/analytic/l_shape/'
 //
 // llvmpipe and lavapipe use as many threads as there are cores unless LP_NUM_THREADS says
-// otherwise; the app's figures were measured with LP_NUM_THREADS=2. --device picks the Vulkan
-// device (an index or a part of its name, as `flatmarch backends` lists them).
+// otherwise. --device=D picks the device of both backends (an index or a part of its name, as
+// `flatmarch backends` lists them); every run is labelled with its device.
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
+#include <map>
 
 #include "backends/opengl/opengl.hpp"
 #include "backends/vulkan/vulkan.hpp"
 #include "bench/gallery.hpp"
+#include "bench/peer_app.hpp"
 #include "scene/peer_import.hpp"
 
-namespace flatmarch {
-namespace {
+namespace flatmarch::bench {
 
 struct Size {
   int width, height;
 };
 constexpr Size kSizes[] = {{640, 360}, {1920, 1080}};
 
+// The app's frame times per view in this run (ms, one a repetition), as peer/app/VIEW measures
+// them; the median is what every other case of the view is compared with.
+std::map<std::string, std::vector<double>> app_ms;
+
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
 void frame(benchmark::State& state, const Backend* backend, const Scene* scene, Camera camera,
-           MarchParams params, Size size, double peer_ms) {
+           MarchParams params, Size size, std::string view) {
+  if (const std::optional<DeviceInfo> d = backend->device())
+    state.SetLabel(reports::device_label(*d));
   // The first frame compiles the scene's program; it is not timed.
   Frame f = backend->render(*scene, camera, size.width, size.height, params, {});
   for (auto _ : state) {
@@ -35,28 +53,42 @@ void frame(benchmark::State& state, const Backend* backend, const Scene* scene, 
     benchmark::DoNotOptimize(f.rgb.data());
   }
   bench::frame_counters(state, f);
-  if (peer_ms > 0.0) {
-    state.counters["peer_ms"] = peer_ms;
+  if (!view.empty() && !app_ms[view].empty()) {
+    const double app = median(app_ms[view]);
+    state.counters["app_ms"] = app;
     // The app's time per frame over ours.
-    state.counters["speedup_vs_peer"] =
-        benchmark::Counter(peer_ms / 1000.0, benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["speedup_vs_app"] =
+        benchmark::Counter(app / 1000.0, benchmark::Counter::kIsIterationInvariantRate);
   }
 }
 
-// The app's benchmark views, with its frame times on this machine kind (Mesa 22.3 llvmpipe,
-// LP_NUM_THREADS=2, 640x360, median of 11 frames, its shaders unchanged; issue 5).
+void app_frame(benchmark::State& state, PeerApp* app, std::string id, std::string view, Size size) {
+  state.SetLabel("device " + app->renderer() + "; the app's shader");
+  try {
+    app->frame(id, size.width, size.height);  // compiles the shader: not timed
+    const auto start = std::chrono::steady_clock::now();
+    for (auto _ : state) app->frame(id, size.width, size.height);
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    app_ms[view].push_back(ms / static_cast<double>(state.iterations()));
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+  }
+}
+
+// The app's benchmark views: its geometry file (in tests/data/peer-geometries, and its shader's
+// name in the app) and ours.
 struct PeerView {
-  const char* file;  // in tests/data/peer-geometries
+  const char* id;
   const char* name;
-  double peer_ms;
 };
-constexpr PeerView kPeerViews[] = {{"L_shape.json", "l_shape", 241.0},
-                                   {"DoublePentagonTranslation.json", "double_pentagon", 473.0},
-                                   {"torus.json", "torus", 352.0},
-                                   {"L_shapePrism.json", "l_shape_prism", 1116.0},
-                                   {"equilateralTriangle.json", "equilateral_triangle", 1929.0},
-                                   {"irrationalTriangle.json", "triangle_1rad", 1992.0},
-                                   {"cube.json", "cube", 4226.0}};
+constexpr PeerView kPeerViews[] = {{"L_shape", "l_shape"},
+                                   {"DoublePentagonTranslation", "double_pentagon"},
+                                   {"torus", "torus"},
+                                   {"L_shapePrism", "l_shape_prism"},
+                                   {"equilateralTriangle", "equilateral_triangle"},
+                                   {"irrationalTriangle", "triangle_1rad"},
+                                   {"cube", "cube"}};
 
 // The app's view: from its start point + (0.5, 0, 0.5), looking along normalize(1, 0, 0.3) in its
 // coordinates (y up). The importer maps its (x, y, z) to our (x, z, y + wall height) and its
@@ -70,23 +102,30 @@ Camera peer_camera(const Scene& scene) {
   return camera;
 }
 
-}  // namespace
-}  // namespace flatmarch
+}  // namespace flatmarch::bench
 
 int main(int argc, char** argv) {
   using namespace flatmarch;
-  // Our own flag first: Google Benchmark reports flags it does not know.
-  BackendOptions vulkan_options;
-  for (int k = 1; k < argc; ++k)
-    if (std::string(argv[k]).rfind("--device=", 0) == 0) {
-      vulkan_options.device = std::string(argv[k]).substr(9);
-      std::copy(argv + k + 1, argv + argc + 1, argv + k);
-      --argc;
-      break;
+  // Our own flags first: Google Benchmark reports flags it does not know.
+  BackendOptions options;
+  std::string peer_shaders =
+      std::getenv("FLATMARCH_PEER_SHADERS") ? std::getenv("FLATMARCH_PEER_SHADERS") : "";
+  for (int k = 1; k < argc;) {
+    const std::string arg = argv[k];
+    if (arg.rfind("--device=", 0) == 0) {
+      options.device = arg.substr(9);
+    } else if (arg.rfind("--peer-shaders=", 0) == 0) {
+      peer_shaders = arg.substr(15);
+    } else {
+      ++k;
+      continue;
     }
+    std::copy(argv + k + 1, argv + argc + 1, argv + k);
+    --argc;
+  }
   if (!bench::begin(argc, argv)) return 2;
-  const OpenGlBackend opengl;
-  const VulkanBackend vulkan(vulkan_options);
+  const OpenGlBackend opengl(options);
+  const VulkanBackend vulkan(options);
   std::vector<const Backend*> available;
   for (const Backend* b :
        {static_cast<const Backend*>(&opengl), static_cast<const Backend*>(&vulkan)})
@@ -96,27 +135,47 @@ int main(int argc, char** argv) {
     else
       available.push_back(b);
   if (available.empty()) return 0;
-  if (!opengl.renderer().empty()) std::cerr << "gpu_bench: opengl on " << opengl.renderer() << "\n";
-  if (vulkan.availability().available) std::cerr << "gpu_bench: " << vulkan.description() << "\n";
+  for (const Backend* b : available) std::cerr << "gpu_bench: " << b->description() << "\n";
+  std::unique_ptr<bench::PeerApp> app;
+  if (peer_shaders.empty()) {
+    std::cerr << "gpu_bench: no --peer-shaders: the app's views are timed without the app's own "
+                 "shaders (../shared/peer-shaders.md says how to regenerate them)\n";
+  } else {
+    try {
+      app = std::make_unique<bench::PeerApp>(peer_shaders, options.device);
+      std::cerr << "gpu_bench: the app's shaders from " << peer_shaders << " on " << app->renderer()
+                << "\n";
+    } catch (const std::exception& e) {
+      std::cerr << "gpu_bench: the app's shaders cannot be drawn, skipped: " << e.what() << "\n";
+    }
+  }
   const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
   std::vector<std::unique_ptr<Scene>> peers;
-  for (const PeerView& view : kPeerViews) {
+  const bench::Size peer_size{640, 360};
+  for (const bench::PeerView& view : bench::kPeerViews) {
+    const std::string file = std::string(view.id) + ".json";
     const PeerImport imported = import_peer_file(std::filesystem::path(FLATMARCH_SOURCE_DIR) /
-                                                 "tests" / "data" / "peer-geometries" / view.file);
-    peers.push_back(std::make_unique<Scene>(scene_from_json(imported.scene, view.file)));
+                                                 "tests" / "data" / "peer-geometries" / file);
+    peers.push_back(std::make_unique<Scene>(scene_from_json(imported.scene, file)));
+    if (app)
+      benchmark::RegisterBenchmark(("peer/app/" + std::string(view.name)).c_str(), bench::app_frame,
+                                   app.get(), std::string(view.id), std::string(view.name),
+                                   peer_size)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
     for (const Backend* backend : available)
       for (Method method : {Method::sphere, Method::relaxed, Method::analytic}) {
         MarchParams params;
         params.method = method;
         benchmark::RegisterBenchmark(
-            ("peer/" + backend->name() + "/" + view.name + "/" + to_string(method)).c_str(), frame,
-            backend, peers.back().get(), peer_camera(*peers.back()), params, Size{640, 360},
-            view.peer_ms)
+            ("peer/" + backend->name() + "/" + view.name + "/" + to_string(method)).c_str(),
+            bench::frame, backend, peers.back().get(), bench::peer_camera(*peers.back()), params,
+            peer_size, std::string(view.name))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
       }
   }
-  for (const Size size : kSizes)
+  for (const bench::Size size : bench::kSizes)
     for (Method method : {Method::sphere, Method::relaxed, Method::analytic})
       for (const auto& scene : scenes)
         for (const Backend* backend : available) {
@@ -126,7 +185,7 @@ int main(int argc, char** argv) {
               (backend->name() + "/" + to_string(method) + "/" + scene->name + "/" +
                std::to_string(size.width) + "x" + std::to_string(size.height))
                   .c_str(),
-              frame, backend, scene.get(), scene->camera, params, size, 0.0)
+              bench::frame, backend, scene.get(), scene->camera, params, size, std::string())
               ->Unit(benchmark::kMillisecond)
               ->UseRealTime();
         }

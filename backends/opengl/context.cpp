@@ -64,7 +64,7 @@ std::vector<Device> list_devices() {
   std::vector<Device> devices;
   for (Candidate& c : candidates()) {
     try {
-      devices.push_back(c.make(c.device)->device());
+      devices.push_back(c.make(c.device, Profile::core)->device());
     } catch (const std::exception& e) {
       c.device.reason = e.what();
       devices.push_back(c.device);
@@ -73,7 +73,7 @@ std::vector<Device> list_devices() {
   return devices;
 }
 
-std::unique_ptr<Context> make_context(const std::string& want) {
+std::unique_ptr<Context> make_context(const std::string& want, Profile profile) {
   std::vector<Candidate> all = candidates();
   std::vector<Candidate*> order;
   if (want.empty()) {
@@ -113,7 +113,7 @@ std::unique_ptr<Context> make_context(const std::string& want) {
   for (Candidate* c : order) {
     if (software && c->device.software) break;
     try {
-      std::unique_ptr<Context> made = c->make(c->device);
+      std::unique_ptr<Context> made = c->make(c->device, profile);
       if (!want.empty() || !made->device().software) return made;
       if (!software) software = std::move(made);
     } catch (const std::exception& e) {

@@ -60,6 +60,10 @@ class Context {
   Device device_;
 };
 
+// What a context offers: OpenGL 4.5 core (the kernel's programs), or the compatibility profile
+// (GLSL 1.20 programs, such as the original web app's shaders that the benchmarks time).
+enum class Profile { core, compatibility };
+
 // Every device EGL lists, then OSMesa's, each tried: a context is made on it (and destroyed) to
 // read its renderer, or the reason it cannot be made is kept.
 std::vector<Device> list_devices();
@@ -68,6 +72,6 @@ std::vector<Device> list_devices();
 // or renderer ("osmesa", "llvmpipe", "nvidia"), case-insensitive. Empty: the first GPU that
 // makes one, else EGL's software device, else OSMesa. Throws std::runtime_error saying why no
 // device matches or none makes a context.
-std::unique_ptr<Context> make_context(const std::string& want);
+std::unique_ptr<Context> make_context(const std::string& want, Profile profile = Profile::core);
 
 }  // namespace flatmarch::gl

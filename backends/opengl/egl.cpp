@@ -92,7 +92,8 @@ bool has(const std::string& extensions, const std::string& name) {
 
 class EglContext final : public Context {
  public:
-  EglContext(const Egl& egl, EGLDisplay display, Device device) : egl_(egl), display_(display) {
+  EglContext(const Egl& egl, EGLDisplay display, Device device, Profile profile)
+      : egl_(egl), display_(display) {
     device_ = std::move(device);
     EGLint major = 0, minor = 0;
     if (display == EGL_NO_DISPLAY || !egl.eglInitialize(display, &major, &minor))
@@ -111,17 +112,20 @@ class EglContext final : public Context {
       if (!egl.eglChooseConfig(display, wanted, &config, 1, &found) || found < 1)
         throw std::runtime_error("this EGL display has no config for desktop OpenGL");
     }
-    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
-                                 4,
-                                 EGL_CONTEXT_MINOR_VERSION,
-                                 5,
-                                 EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                 EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                 EGL_NONE};
+    const bool core = profile == Profile::core;
+    const EGLint attributes[] = {
+        EGL_CONTEXT_MAJOR_VERSION,
+        core ? 4 : 1,
+        EGL_CONTEXT_MINOR_VERSION,
+        core ? 5 : 0,
+        EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        core ? EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT : EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT,
+        EGL_NONE};
     context_ = egl.eglCreateContext(display, config, EGL_NO_CONTEXT, attributes);
     if (context_ == EGL_NO_CONTEXT)
-      throw std::runtime_error("EGL cannot make an OpenGL 4.5 core context here (" + egl.error() +
-                               ")");
+      throw std::runtime_error(std::string("EGL cannot make an OpenGL ") +
+                               (core ? "4.5 core" : "compatibility") + " context here (" +
+                               egl.error() + ")");
     if (!surfaceless) {
       const EGLint size[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
       surface_ = egl.eglCreatePbufferSurface(display, config, size);
@@ -172,7 +176,9 @@ class EglContext final : public Context {
 Candidate unusable(const std::string& why) {
   Candidate c;
   c.device.platform = "EGL";
-  c.make = [why](const Device&) -> std::unique_ptr<Context> { throw std::runtime_error(why); };
+  c.make = [why](const Device&, Profile) -> std::unique_ptr<Context> {
+    throw std::runtime_error(why);
+  };
   return c;
 }
 
@@ -202,9 +208,10 @@ std::vector<Candidate> egl_candidates() {
         c.device.node = Egl::text(e->eglQueryDeviceStringEXT(handle, EGL_DRM_RENDER_NODE_FILE_EXT));
       else if (has(extensions, "EGL_EXT_device_drm"))
         c.device.node = Egl::text(e->eglQueryDeviceStringEXT(handle, EGL_DRM_DEVICE_FILE_EXT));
-      c.make = [e, handle](const Device& device) -> std::unique_ptr<Context> {
+      c.make = [e, handle](const Device& device, Profile profile) -> std::unique_ptr<Context> {
         return std::make_unique<EglContext>(
-            *e, e->eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, handle, nullptr), device);
+            *e, e->eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, handle, nullptr), device,
+            profile);
       };
       found.push_back(std::move(c));
     }
@@ -213,11 +220,11 @@ std::vector<Candidate> egl_candidates() {
       has(e->client_extensions, "EGL_MESA_platform_surfaceless")) {
     Candidate c;
     c.device.platform = "EGL surfaceless";
-    c.make = [e](const Device& device) -> std::unique_ptr<Context> {
+    c.make = [e](const Device& device, Profile profile) -> std::unique_ptr<Context> {
       return std::make_unique<EglContext>(
           *e,
           e->eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr),
-          device);
+          device, profile);
     };
     found.push_back(std::move(c));
   }

@@ -36,6 +36,7 @@ using BindTextureProc = void(APIENTRYP)(GLenum target, GLuint texture);
   X(PFNGLUSEPROGRAMPROC, UseProgram)                           \
   X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)           \
   X(PFNGLUNIFORM1IPROC, Uniform1i)                             \
+  X(PFNGLUNIFORM1FPROC, Uniform1f)                             \
   X(PFNGLUNIFORM2FPROC, Uniform2f)                             \
   X(PFNGLUNIFORM3FPROC, Uniform3f)                             \
   X(PFNGLUNIFORM4FPROC, Uniform4f)                             \

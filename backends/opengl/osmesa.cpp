@@ -47,22 +47,24 @@ void* proc(const char* name) {
 
 class OsMesaContext final : public Context {
  public:
-  explicit OsMesaContext(Device device) : osmesa_(osmesa()) {
+  OsMesaContext(Device device, Profile profile) : osmesa_(osmesa()) {
     device_ = std::move(device);
+    const bool core = profile == Profile::core;
     const int attributes[] = {OSMESA_FORMAT,
                               OSMESA_RGBA,
                               OSMESA_DEPTH_BITS,
                               0,
                               OSMESA_PROFILE,
-                              OSMESA_CORE_PROFILE,
+                              core ? OSMESA_CORE_PROFILE : OSMESA_COMPAT_PROFILE,
                               OSMESA_CONTEXT_MAJOR_VERSION,
-                              4,
+                              core ? 4 : 1,
                               OSMESA_CONTEXT_MINOR_VERSION,
-                              5,
+                              core ? 5 : 0,
                               0};
     context_ = osmesa_.create(attributes, nullptr);
     if (context_ == nullptr)
-      throw std::runtime_error("OSMesa cannot create an OpenGL 4.5 core context here");
+      throw std::runtime_error(core ? "OSMesa cannot create an OpenGL 4.5 core context here"
+                                    : "OSMesa cannot create a compatibility context here");
     try {
       const Current current(*this);
       load(proc);
@@ -92,8 +94,8 @@ Candidate osmesa_candidate() {
   Candidate c;
   c.device.platform = "OSMesa";
   c.device.software = true;
-  c.make = [](const Device& device) -> std::unique_ptr<Context> {
-    return std::make_unique<OsMesaContext>(device);
+  c.make = [](const Device& device, Profile profile) -> std::unique_ptr<Context> {
+    return std::make_unique<OsMesaContext>(device, profile);
   };
   return c;
 }

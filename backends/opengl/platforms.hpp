@@ -9,11 +9,12 @@
 
 namespace flatmarch::gl {
 
-// A device and how to make a context on it: make(device) throws std::runtime_error saying why
-// not. The device's index is set by the caller; its strings are filled in once a context is made.
+// A device and how to make a context on it: make(device, profile) throws std::runtime_error
+// saying why not. The device's index is set by the caller; its strings are filled in once a
+// context is made.
 struct Candidate {
   Device device;
-  std::function<std::unique_ptr<Context>(const Device&)> make;
+  std::function<std::unique_ptr<Context>(const Device&, Profile)> make;
 };
 
 // EGL's devices, in its order (the device platform), or Mesa's surfaceless display where EGL

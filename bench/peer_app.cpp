@@ -1,0 +1,123 @@
+#include "bench/peer_app.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "backends/opengl/gl_kernel.hpp"
+
+namespace flatmarch::bench {
+
+namespace {
+
+// The app's shaders are GLSL 1.20 without a version line (peer-shaders.md); generic attribute 0
+// is gl_Vertex in the compatibility profile.
+const char* const kVertexShader = "#version 120\nvoid main() { gl_Position = gl_Vertex; }\n";
+
+std::string read(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot read " + file.string());
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+struct PeerApp::Program {
+  const gl::Api& gl;
+  GLuint program;
+  GLint resolution, time, position, front, up;
+  ~Program() { gl.DeleteProgram(program); }
+};
+
+PeerApp::PeerApp(const std::filesystem::path& folder, const std::string& device) : folder_(folder) {
+  const nlohmann::json meta = nlohmann::json::parse(read(folder / "meta.json"));
+  for (const auto& [id, m] : meta.items()) {
+    const auto p = m.value("initialPosition", std::vector<float>{0.0f, 1.0f, 0.0f});
+    start_[id] = glm::vec3(p.at(0), p.at(1), p.at(2));
+  }
+  context_ = gl::make_context(device, gl::Profile::compatibility);
+  const gl::Context::Current current(*context_);
+  const gl::Api& gl = context_->api();
+  const float triangle[] = {-1.0f, -1.0f, 3.0f, -1.0f, -1.0f, 3.0f};
+  gl.GenVertexArrays(1, &vertex_array_);
+  gl.BindVertexArray(vertex_array_);
+  gl.GenBuffers(1, &vertices_);
+  gl.BindBuffer(GL_ARRAY_BUFFER, vertices_);
+  gl.BufferData(GL_ARRAY_BUFFER, sizeof triangle, triangle, GL_STATIC_DRAW);
+  gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  gl.EnableVertexAttribArray(0);
+}
+
+PeerApp::~PeerApp() {
+  const gl::Context::Current current(*context_);
+  const gl::Api& gl = context_->api();
+  programs_.clear();
+  gl.DeleteBuffers(1, &vertices_);
+  gl.DeleteVertexArrays(1, &vertex_array_);
+  if (framebuffer_ != 0) gl.DeleteFramebuffers(1, &framebuffer_);
+  if (texture_ != 0) gl.DeleteTextures(1, &texture_);
+}
+
+std::string PeerApp::renderer() const {
+  return context_->device().renderer + ", " + context_->device().version;
+}
+
+PeerApp::Program& PeerApp::program(const std::string& id) {
+  auto& p = programs_[id];
+  if (!p) {
+    const gl::Api& gl = context_->api();
+    const GLuint program =
+        gl::link_program(gl, kVertexShader, "#version 120\n" + read(folder_ / (id + ".frag")));
+    // Made in place: a temporary Program would delete the GL program as it goes.
+    p.reset(new Program{gl, program, gl.GetUniformLocation(program, "iResolution"),
+                        gl.GetUniformLocation(program, "iTime"),
+                        gl.GetUniformLocation(program, "rayMarchCamPos"),
+                        gl.GetUniformLocation(program, "rayMarchCamFront"),
+                        gl.GetUniformLocation(program, "rayMarchCamUp")});
+  }
+  return *p;
+}
+
+void PeerApp::frame(const std::string& id, int width, int height) {
+  if (!start_.count(id)) throw std::runtime_error(id + " is not in meta.json");
+  const gl::Context::Current current(*context_);
+  const gl::Api& gl = context_->api();
+  if (width != width_ || height != height_) {
+    if (framebuffer_ == 0) {
+      gl.GenFramebuffers(1, &framebuffer_);
+      gl.GenTextures(1, &texture_);
+    }
+    gl.BindTexture(GL_TEXTURE_2D, texture_);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture_, 0);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("the app's framebuffer is incomplete");
+    width_ = width;
+    height_ = height;
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
+  const Program& p = program(id);
+  const glm::vec3 from = start_[id] + glm::vec3(0.5f, 0.0f, 0.5f);
+  const glm::vec3 front = glm::normalize(glm::vec3(1.0f, 0.0f, 0.3f));
+  gl.UseProgram(p.program);
+  gl.Uniform2f(p.resolution, static_cast<float>(width), static_cast<float>(height));
+  gl.Uniform1f(p.time, 0.0f);
+  gl.Uniform3f(p.position, from.x, from.y, from.z);
+  gl.Uniform3f(p.front, front.x, front.y, front.z);
+  gl.Uniform3f(p.up, 0.0f, 1.0f, 0.0f);
+  gl.Viewport(0, 0, width, height);
+  gl.BindVertexArray(vertex_array_);
+  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  std::vector<unsigned char> pixels(4 * static_cast<size_t>(width) * static_cast<size_t>(height));
+  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+  if (const std::string e = gl::errors(gl); !e.empty())
+    throw std::runtime_error("the app's frame failed: " + e);
+}
+
+}  // namespace flatmarch::bench
