@@ -64,7 +64,7 @@ nlohmann::json hardware_fingerprint() {
     fp["opengl"] = {{"unavailable", opengl.availability().reason}};
   const VulkanBackend vulkan;
   if (const std::optional<DeviceInfo> d = vulkan.device()) {
-    const vulkan::Device& listed = vulkan.devices().at(static_cast<size_t>(vulkan.device_index()));
+    const vulkan::Device listed = vulkan.devices().at(static_cast<size_t>(vulkan.device_index()));
     fp["vulkan"] = {{"device", d->name},
                     {"type", d->type},
                     {"api", listed.api},
