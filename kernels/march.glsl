@@ -313,8 +313,24 @@ void hit_solid(INOUT(Ray) r, int k) {
 }
 
 void solid_look(INOUT(Ray) r) {
+#ifdef FLATMARCH_FEW_OBJECTS
+  // A few objects baked in: each solid's normal is evaluated with the solid's shape known (its
+  // number a constant), and the one hit kept, rather than every shape's distance at a per-ray
+  // index.
+  vec3 normal = vec3(real(0));
+  vec4 color = vec4(real(0));
+  for (int k = 0; k < objects.length(); ++k) {
+    if (k == r.object) {
+      normal = solid_normal(k, r.o);
+      color = objects[k].color;
+    }
+  }
+  r.normal = normal;
+  r.surface = solid_surface(color, normal);
+#else
   r.normal = solid_normal(r.object, r.o);
   r.surface = solid_surface(objects[r.object].color, r.normal);
+#endif
 }
 
 // ---- Methods ---------------------------------------------------------------------------------
@@ -390,29 +406,25 @@ void move_in_segment(INOUT(Ray) r, INOUT(Segment) seg, real s) {
   seg.solids = max(seg.solids - s, real(0));
 }
 
-// One iteration of the analytic method: a step of sphere tracing towards a solid, or the whole
-// rest of the room segment.
-void analytic_step(INOUT(Ray) r, INOUT(Segment) seg) {
+// The room segment from the ray's point, unless it is known.
+void find_segment(INOUT(Ray) r, INOUT(Segment) seg) {
   if (!seg.known) {
     seg.exit = exit_edge(r.polygon, vec2(r.o), vec2(r.d));
     seg.solids = has(kFeatureObjects) ? solid_entry(r.polygon, r.o, r.d) : real(kFar);
     seg.known = true;
   }
+}
+
+// Whether the known segment reaches a solid's bounding sphere before it ends (the end of the
+// room, of the band or of max_distance).
+bool near_solid(Ray r, Segment seg) {
+  return has(kFeatureObjects) && seg.known &&
+         seg.solids < min(min(seg.exit.s, band_exit(r.o, r.d)), params.max_distance - r.t);
+}
+
+// The rest of the room segment: the ray leaves the band, ends, or crosses the exit edge.
+void segment_step(INOUT(Ray) r, INOUT(Segment) seg) {
   real remaining = params.max_distance - r.t;
-  if (has(kFeatureObjects) &&
-      seg.solids < min(min(seg.exit.s, band_exit(r.o, r.d)), remaining)) {
-    move_in_segment(r, seg, seg.solids);  // nothing to meet before the first bounding sphere
-    SolidDistance solid = nearest_solid(r.polygon, r.o);
-    if (solid.d < params.eps) {
-      hit_solid(r, solid.object);
-      return;
-    }
-    remaining = params.max_distance - r.t;
-    if (solid.d < min(min(seg.exit.s, band_exit(r.o, r.d)), remaining)) {
-      move_in_segment(r, seg, solid.d);
-      return;
-    }
-  }
   real band = band_exit(r.o, r.d);
   if (remaining < min(seg.exit.s, band)) {
     finish(r, kHitMaxDistance, kEventMaxDistance, -1, remaining);
@@ -428,6 +440,26 @@ void analytic_step(INOUT(Ray) r, INOUT(Segment) seg) {
     cross_edge(r, seg.exit.edge, real(0));
     seg.known = false;
   }
+}
+
+// One iteration of the analytic method: a step of sphere tracing towards a solid, or the whole
+// rest of the room segment.
+void analytic_step(INOUT(Ray) r, INOUT(Segment) seg) {
+  find_segment(r, seg);
+  bool whole = true;  // the step takes the rest of the segment
+  if (near_solid(r, seg)) {
+    move_in_segment(r, seg, seg.solids);  // nothing to meet before the first bounding sphere
+    SolidDistance solid = nearest_solid(r.polygon, r.o);
+    if (solid.d < params.eps) {
+      hit_solid(r, solid.object);
+      whole = false;
+    } else if (solid.d <
+               min(min(seg.exit.s, band_exit(r.o, r.d)), params.max_distance - r.t)) {
+      move_in_segment(r, seg, solid.d);
+      whole = false;
+    }
+  }
+  if (whole) segment_step(r, seg);
 }
 
 // ---- A whole ray -----------------------------------------------------------------------------
@@ -490,12 +522,41 @@ Ray march(int polygon, vec3 from, vec3 dir) {
   seg.exit.edge = -1;
   seg.exit.corner = false;
   seg.solids = real(kFar);
-  for (int i = 0; i < params.max_steps && !r.done; ++i) {
-    r.steps += 1;
-    if (params.method == kMethodAnalytic) {
-      analytic_step(r, seg);
+  // The loops test at their end (do-while), and every step is one iteration: a shader core runs
+  // a loop's body, masked, until no lane is left in it, and a test at the top costs a whole
+  // masked pass more.
+  if (params.max_steps > 0 && !r.done) {
+    if (params.method == kMethodAnalytic && has(kFeatureObjects)) {
+      // The analytic method's steps, in two loops: the steps that take a whole room segment, as
+      // long as no solid is near, then the steps near solids, and again. The same steps in the
+      // same order as analytic_step's loop, but the solids' distances are evaluated only in the
+      // second loop, which most rays never enter or enter once.
+      do {
+        bool near = false;
+        do {
+          find_segment(r, seg);
+          near = near_solid(r, seg);
+          if (!near) {
+            r.steps += 1;
+            segment_step(r, seg);
+          }
+        } while (!r.done && r.steps < params.max_steps && !near);
+        if (!r.done && r.steps < params.max_steps) {
+          do {
+            r.steps += 1;
+            analytic_step(r, seg);
+          } while (!r.done && r.steps < params.max_steps && near_solid(r, seg));
+        }
+      } while (!r.done && r.steps < params.max_steps);
     } else {
-      sphere_step(r, x);
+      do {
+        r.steps += 1;
+        if (params.method == kMethodAnalytic) {
+          analytic_step(r, seg);
+        } else {
+          sphere_step(r, x);
+        }
+      } while (!r.done && r.steps < params.max_steps);
     }
   }
   if (!r.done) finish(r, kHitMaxSteps, kEventMaxSteps, -1, real(0));

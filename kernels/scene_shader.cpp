@@ -8,6 +8,9 @@ namespace flatmarch::kernel {
 
 namespace {
 
+// Up to this many objects, a baked shader finds a hit solid's normal with the solid's shape known.
+constexpr size_t kFewObjects = 4;
+
 // Nine significant digits read back as the same float.
 std::string number(float x) {
   char text[32];
@@ -141,6 +144,8 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays)
                return "ObjectRecord(" + vec4_literal(o.center) + ", " + vec4_literal(o.shape) +
                       ", " + vec4_literal(o.color) + ", " + ivec4_literal(o.info) + ")";
              });
+  // kernels/march.glsl's solid_look then evaluates each solid's normal with its shape known.
+  if (tables.objects.size() <= kFewObjects) s += "#define FLATMARCH_FEW_OBJECTS\n";
   return s + baked_params(tables.params);
 }
 
