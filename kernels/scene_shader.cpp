@@ -50,6 +50,7 @@ uniform vec3 u_right;
 uniform vec3 u_up;
 uniform vec2 u_scale;
 uniform vec2 u_size;
+uniform vec2 u_rows;  // the pixel's row from the top is u_rows.x + u_rows.y * gl_FragCoord.y
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out vec4 out_aov;
@@ -62,8 +63,9 @@ void main() {
   out_aov = vec4(0.0);
 #else
   // DESIGN.md section 2: x from the left, y from the top, through the pixel's centre
-  // (gl_FragCoord is at the centre, counted from the bottom).
-  vec2 p = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);
+  // (gl_FragCoord is at the centre). The image's top row is OpenGL's top row (u_rows = (height,
+  // -1)), or its first row in memory, row 0 (u_rows = (0, 1)), as a read-back wants it.
+  vec2 p = vec2(gl_FragCoord.x, u_rows.x + u_rows.y * gl_FragCoord.y);
   float u = (2.0 * p.x / u_size.x - 1.0) * u_scale.x;
   float v = (1.0 - 2.0 * p.y / u_size.y) * u_scale.y;
   Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));

@@ -66,8 +66,7 @@ RenderTargets::RenderTargets(const Api& gl, int width, int height)
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(k),
                             GL_TEXTURE_2D, textures_[k], 0);
   }
-  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  gl.DrawBuffers(2, buffers);
+  bind();
   if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
     gl.DeleteTextures(2, textures_);
@@ -75,6 +74,12 @@ RenderTargets::RenderTargets(const Api& gl, int width, int height)
     throw std::runtime_error("OpenGL cannot draw to float targets of " + std::to_string(width) +
                              "x" + std::to_string(height));
   }
+}
+
+void RenderTargets::bind() const {
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
+  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl_.DrawBuffers(2, buffers);
 }
 
 RenderTargets::~RenderTargets() {
@@ -94,6 +99,7 @@ KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& ta
   up_ = gl.GetUniformLocation(program_, "u_up");
   scale_ = gl.GetUniformLocation(program_, "u_scale");
   size_ = gl.GetUniformLocation(program_, "u_size");
+  rows_ = gl.GetUniformLocation(program_, "u_rows");
   gl.GenVertexArrays(1, &vertex_array_);  // the core profile draws only with one bound
   if (trace) gl.GenBuffers(1, &events_);
 }
@@ -105,7 +111,7 @@ KernelProgram::~KernelProgram() {
 }
 
 void KernelProgram::draw(const CameraBasis<float>& c, int polygon, glm::vec3 from, int width,
-                         int height) const {
+                         int height, Rows rows) const {
   gl_.UseProgram(program_);
   gl_.Uniform1i(polygon_, polygon);
   gl_.Uniform3f(from_, from.x, from.y, from.z);
@@ -114,6 +120,10 @@ void KernelProgram::draw(const CameraBasis<float>& c, int polygon, glm::vec3 fro
   gl_.Uniform3f(up_, c.up.x, c.up.y, c.up.z);
   gl_.Uniform2f(scale_, c.aspect * c.tan_half_fov, c.tan_half_fov);
   gl_.Uniform2f(size_, static_cast<float>(width), static_cast<float>(height));
+  if (rows == Rows::top_up)
+    gl_.Uniform2f(rows_, static_cast<float>(height), -1.0f);
+  else
+    gl_.Uniform2f(rows_, 0.0f, 1.0f);
   gl_.BindVertexArray(vertex_array_);
   gl_.DrawArrays(GL_TRIANGLES, 0, 3);
 }

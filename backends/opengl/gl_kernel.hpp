@@ -27,6 +27,8 @@ class RenderTargets {
   RenderTargets(const RenderTargets&) = delete;
   RenderTargets& operator=(const RenderTargets&) = delete;
   GLuint framebuffer() const { return framebuffer_; }
+  // Binds the framebuffer for drawing to both targets again (after another was bound).
+  void bind() const;
   GLuint colour() const { return textures_[0]; }
   GLuint aovs() const { return textures_[1]; }
   int width() const { return width_; }
@@ -48,10 +50,19 @@ class KernelProgram {
   KernelProgram(const KernelProgram&) = delete;
   KernelProgram& operator=(const KernelProgram&) = delete;
 
+  // Where a drawn image's rows go: the image's top row at the framebuffer's top, as a window
+  // shows it, or at its row 0, the first in memory, as glReadPixels returns it.
+  enum class Rows { top_up, top_first };
+
   // Draws the camera's view of a width x height image into the bound framebuffer's draw
   // buffers 0 (colour) and 1 (AOVs), over its viewport: every pixel within the scissor box.
-  void draw(const CameraBasis<float>& camera, int polygon, glm::vec3 from, int width,
-            int height) const;
+  void draw(const CameraBasis<float>& camera, int polygon, glm::vec3 from, int width, int height,
+            Rows rows = Rows::top_up) const;
+
+  // The pace of the last frame drawn, seconds per pixel (BandPacer::pace; 0 before the first),
+  // by which the next frame's bands are sized.
+  double seconds_per_pixel() const { return seconds_per_pixel_; }
+  void set_seconds_per_pixel(double s) const { seconds_per_pixel_ = s; }
 
   // Marches one ray in a 1 x 1 viewport of the bound framebuffer (a trace program only).
   Trace trace(const Ray& ray, int max_events) const;
@@ -60,7 +71,9 @@ class KernelProgram {
   const Api& gl_;
   bool trace_;
   GLuint program_ = 0, vertex_array_ = 0, events_ = 0;
-  GLint polygon_ = -1, from_ = -1, forward_ = -1, right_ = -1, up_ = -1, scale_ = -1, size_ = -1;
+  GLint polygon_ = -1, from_ = -1, forward_ = -1, right_ = -1, up_ = -1, scale_ = -1, size_ = -1,
+        rows_ = -1;
+  mutable double seconds_per_pixel_ = 0.0;
 };
 
 }  // namespace flatmarch::gl

@@ -1,9 +1,11 @@
 #include "backends/opengl/opengl.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <mutex>
 #include <stdexcept>
 
+#include "backends/bands.hpp"
 #include "backends/opengl/context.hpp"
 #include "backends/opengl/gl_api.hpp"
 #include "backends/opengl/gl_kernel.hpp"
@@ -14,9 +16,6 @@ namespace flatmarch {
 
 namespace {
 
-// Rows drawn per draw call: a frame is drawn in bands so that progress can be reported and no
-// single draw runs for long (a GPU driver's watchdog would end it).
-constexpr int kBandRows = 64;
 // Compiled programs kept per context (a program is a scene, its march parameters and a variant).
 constexpr size_t kProgramCache = 16;
 
@@ -26,6 +25,8 @@ struct OpenGlBackend::Context {
   std::unique_ptr<gl::Context> gl_context;
   GLint max_size = 0;
   std::mutex mutex;  // one frame or trace at a time; the context is current only during one
+  std::unique_ptr<gl::RenderTargets> targets;  // the last frame's, kept for the next one
+  std::vector<float> aovs;                     // read-back of the AOV target, reused
   // Programs by their fragment source, least recently used first.
   std::vector<std::pair<std::string, std::unique_ptr<gl::KernelProgram>>> programs;
 
@@ -52,6 +53,7 @@ struct OpenGlBackend::Context {
     try {
       const gl::Context::Current current(*gl_context);
       programs.clear();
+      targets.reset();
     } catch (const std::exception&) {
       // The context cannot be made current: its programs go with it.
     }
@@ -149,40 +151,49 @@ Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width,
   const gl::Api& gl = c.gl();
   gl.GetError();  // a clean slate for the check below
   gl::KernelProgram& program = c.program(tables, false);
-  const gl::RenderTargets targets(gl, width, height);
+  if (!c.targets || c.targets->width() != width || c.targets->height() != height) {
+    c.targets.reset();
+    c.targets = std::make_unique<gl::RenderTargets>(gl, width, height);
+  }
+  c.targets->bind();
   gl.Viewport(0, 0, width, height);
   gl.Enable(GL_SCISSOR_TEST);
   const CameraBasis<float> basis = camera_basis<float>(
       float(camera.yaw_deg), float(camera.pitch_deg), float(camera.fov_deg), width, height);
-  for (int row = 0; row < height; row += kBandRows) {
-    const int rows = std::min(kBandRows, height - row);
-    gl.Scissor(0, height - row - rows, width, rows);  // GL counts rows from the bottom
-    program.draw(basis, camera.polygon, glm::vec3(camera.position), width, height);
+  // The image's row j is drawn at OpenGL's row j, so that the read-back is in the frame's order.
+  BandPacer bands(program.seconds_per_pixel(), width, height);
+  for (int row = 0, rows = 0; row < height; row += rows) {
+    rows = bands.rows(row);
+    const auto start = std::chrono::steady_clock::now();
+    gl.Scissor(0, row, width, rows);
+    program.draw(basis, camera.polygon, glm::vec3(camera.position), width, height,
+                 gl::KernelProgram::Rows::top_first);
     gl.Finish();
+    bands.done(rows,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (progress) progress(static_cast<double>(row + rows) / height);
   }
+  program.set_seconds_per_pixel(bands.pace());
   gl.Disable(GL_SCISSOR_TEST);
 
+  // The colour straight into the frame; the AOVs through one read, spread into their channels.
   Frame frame(width, height);
   const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
-  std::vector<float> colour(4 * pixels), aov(4 * pixels);
+  c.aovs.resize(4 * pixels);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, colour.data());
+  gl.ReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, frame.rgb.data());
   gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, aov.data());
+  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, c.aovs.data());
   if (const std::string e = gl::errors(gl); !e.empty())
     throw std::runtime_error("the opengl backend failed to render: " + e);
-  for (int j = 0; j < height; ++j)
-    for (int i = 0; i < width; ++i) {
-      const size_t from = 4 * (static_cast<size_t>(height - 1 - j) * width + i);
-      const size_t to = frame.pixel(i, j);
-      for (int n = 0; n < 3; ++n) frame.rgb[3 * to + n] = colour[from + n];
-      frame.steps[to] = aov[from];
-      frame.crossings[to] = aov[from + 1];
-      frame.hit[to] = aov[from + 2];
-      frame.t[to] = aov[from + 3];
-    }
+  const float* aov = c.aovs.data();
+  for (size_t px = 0; px < pixels; ++px, aov += 4) {
+    frame.steps[px] = aov[0];
+    frame.crossings[px] = aov[1];
+    frame.hit[px] = aov[2];
+    frame.t[px] = aov[3];
+  }
   return frame;
 }
 
@@ -205,6 +216,7 @@ Trace OpenGlBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   const gl::Api& gl = c.gl();
   gl.GetError();
   gl::KernelProgram& program = c.program(tables, true);
+  c.targets.reset();  // bound while it lives; a trace draws to one pixel
   const gl::RenderTargets targets(gl, 1, 1);
   Trace trace = program.trace(ray, max_events);
   if (const std::string e = gl::errors(gl); !e.empty())

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
@@ -17,6 +18,7 @@
 #include <link.h>
 #endif
 
+#include "backends/bands.hpp"
 #include "backends/kernel_trace.hpp"
 #include "backends/process_exit.hpp"
 #include "backends/vulkan/spirv.hpp"
@@ -27,9 +29,6 @@ namespace flatmarch {
 
 namespace {
 
-// Rows per dispatch: a frame is marched in bands so that progress can be reported and no single
-// dispatch runs for long (a GPU driver's watchdog would end it).
-constexpr int kBandRows = 64;
 // Compiled pipelines kept (a pipeline is a scene, its march parameters and a variant).
 constexpr size_t kPipelineCache = 16;
 // How long one band may take before the device is given up on.
@@ -170,7 +169,12 @@ struct VulkanBackend::Context {
   bool force_staging = false;  // BackendOptions::vk_staging
   std::mutex mutex;            // one frame or trace at a time
   // Pipelines by their source, least recently used first.
-  std::vector<std::pair<std::string, vk::raii::Pipeline>> pipelines;
+  struct CachedPipeline {
+    std::string source;
+    vk::raii::Pipeline pipeline;
+    double pace = 0.0;  // of its last frame (BandPacer::pace)
+  };
+  std::vector<CachedPipeline> pipelines;  // least recently used first
 
   std::string device_text() const {
     const vulkan::Device& d = devices[static_cast<size_t>(chosen)];
@@ -273,18 +277,18 @@ struct VulkanBackend::Context {
     return vk::raii::Pipeline(device, nullptr, info);
   }
 
-  vk::Pipeline pipeline(const kernel::SceneTables<float>& tables, bool trace) {
+  CachedPipeline& pipeline(const kernel::SceneTables<float>& tables, bool trace) {
     std::string key = kernel::scene_compute_shader(tables, trace);
     auto it = std::find_if(pipelines.begin(), pipelines.end(),
-                           [&](const auto& p) { return p.first == key; });
+                           [&](const CachedPipeline& p) { return p.source == key; });
     if (it == pipelines.end()) {
       vk::raii::Pipeline made = make_pipeline(key);
       if (pipelines.size() == kPipelineCache) pipelines.erase(pipelines.begin());
-      pipelines.emplace_back(std::move(key), std::move(made));
+      pipelines.push_back({std::move(key), std::move(made)});
     } else {
       std::rotate(it, it + 1, pipelines.end());  // now the most recently used
     }
-    return *pipelines.back().second;
+    return pipelines.back();
   }
 
   // Records commands with `record`, runs them and waits for them, at most kBandTimeoutNs.
@@ -580,7 +584,8 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const ValidationCheck check(validation_);
   const std::lock_guard<std::mutex> lock(c.mutex);
-  const vk::Pipeline pipeline = c.pipeline(tables, false);
+  Context::CachedPipeline& cached = c.pipeline(tables, false);
+  const vk::Pipeline pipeline = *cached.pipeline;
   c.reserve_pixels(bytes);
 
   const CameraBasis<float> basis = camera_basis<float>(
@@ -593,9 +598,11 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
       .up = glm::vec4(basis.up, 0.0f),
       .scale = glm::vec4(basis.aspect * basis.tan_half_fov, basis.tan_half_fov, 0.0f, 0.0f),
       .frame = glm::ivec4(width, height, 0, camera.polygon)};
-  for (int row = 0; row < height; row += kBandRows) {
-    const int rows = std::min(kBandRows, height - row);
+  BandPacer bands(cached.pace, width, height, kernel::kComputeTile);
+  for (int row = 0, rows = 0; row < height; row += rows) {
+    rows = bands.rows(row);
     const bool last = row + rows == height;
+    const auto start = std::chrono::steady_clock::now();
     constants.frame.z = row;
     c.run([&](const vk::raii::CommandBuffer& cmd) {
       cmd.bindPipeline(vk::PipelineBindPoint::eCompute, pipeline);
@@ -625,8 +632,11 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
       cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eHost,
                           {}, to_host, {}, {});
     });
+    bands.done(rows,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (progress) progress(static_cast<double>(row + rows) / height);
   }
+  cached.pace = bands.pace();
 
   Frame frame(width, height);
   const auto* planes =
@@ -656,7 +666,7 @@ Trace VulkanBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const ValidationCheck check(validation_);
   const std::lock_guard<std::mutex> lock(c.mutex);
-  const vk::Pipeline pipeline = c.pipeline(tables, true);
+  const vk::Pipeline pipeline = *c.pipeline(tables, true).pipeline;
   const size_t bytes = shader_trace_bytes(max_events);
   c.reserve_events(bytes);
   const ShaderEventHeader header{0, max_events, 0, 0};
