@@ -511,9 +511,12 @@ Ray march(int polygon, vec3 from, vec3 dir) {
   r.surface = vec3(real(0));
   if (has(kFeaturePeriod)) {
     r.o.z = mod(r.o.z, params.top);
-  } else if (r.o.z < real(0) || r.o.z > params.height) {
+  }
+#ifndef FLATMARCH_FROM_BAND
+  else if (r.o.z < real(0) || r.o.z > params.height) {
     enter_band(r);
   }
+#endif
   Relaxation x;
   relax(x);
   Segment seg;

@@ -151,12 +151,23 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays)
   return s + baked_params(tables.params);
 }
 
-std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace) {
-  return shader_source(tables.features, baked_tables(tables), trace) + kFragmentMain;
+namespace {
+const char* const kFromBand = "#define FLATMARCH_FROM_BAND\n";
+}  // namespace
+
+bool within_band(const SceneTables<float>& tables, const glm::dvec3& position) {
+  const float z = static_cast<float>(position.z);  // as the shader receives it
+  return !(z < 0.0f || z > tables.params.height);
 }
 
-std::string scene_compute_shader(const SceneTables<float>& tables, bool trace) {
-  return shader_source(tables.features, baked_tables(tables, false), trace) + "\n#define TILE " +
+std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace, bool from_band) {
+  const std::string baked = baked_tables(tables) + (from_band && !trace ? kFromBand : "");
+  return shader_source(tables.features, baked, trace) + kFragmentMain;
+}
+
+std::string scene_compute_shader(const SceneTables<float>& tables, bool trace, bool from_band) {
+  const std::string baked = baked_tables(tables, false) + (from_band && !trace ? kFromBand : "");
+  return shader_source(tables.features, baked, trace) + "\n#define TILE " +
          std::to_string(kComputeTile) + "\n" + kComputeMain;
 }
 

@@ -27,7 +27,15 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays 
 // Outputs: location 0 the linear colour (rgb, 1), location 1 the AOVs (steps, crossings, hit, t).
 // With `trace` it marches one probe ray instead (u_polygon, u_from and the direction u_forward)
 // and writes its events to the event buffer (binding 4, see kernels/shader_prelude.glsl).
-std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace = false);
+// `from_band`: every ray starts within the band [0, height] (a camera there, not a probe ray):
+// the shader then leaves out how a ray from outside enters the band. llvmpipe and lavapipe run
+// the code of every branch for every pixel, taken or not and uniform or not, and the entry tests
+// the ray against every polygon's footprint (0.4 of the L-shape's 13 ms a 640x360 frame).
+std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace = false,
+                                  bool from_band = false);
+
+// Whether a camera at `position` sees from within the band, as the kernel tests it.
+bool within_band(const SceneTables<float>& tables, const glm::dvec3& position);
 
 // The compute shader of the Vulkan backend: the same kernel and tables, one invocation a pixel in
 // workgroups of kComputeTile x kComputeTile, over rows frame.z .. of the image (a band). Push
@@ -42,7 +50,8 @@ std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace =
 // lavapipe took 35 s to compile (the plain arrays: 2.4 s, and 0.3 s once SPIRV-Tools' optimiser
 // has run, which in turn made the `const` arrays' copies run 300x slower). Tables in buffers ran
 // 1.4-15x slower: their loads are not folded where the indices are constant.
-std::string scene_compute_shader(const SceneTables<float>& tables, bool trace = false);
+std::string scene_compute_shader(const SceneTables<float>& tables, bool trace = false,
+                                 bool from_band = false);
 
 // The compute shader's push constants (std430: as laid out in C++).
 struct ComputeConstants {

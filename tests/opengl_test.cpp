@@ -5,6 +5,7 @@
 // here.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -16,6 +17,7 @@
 #include "backends/opengl/opengl.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "kernels/scene_shader.hpp"
+#include "tests/band_views.hpp"
 #include "tests/gallery.hpp"
 #include "tests/opengl_backend.hpp"
 #include "tests/oracle_compare.hpp"
@@ -96,6 +98,27 @@ TEST(OpenGl, ImageRowsAreTopDownAsDesignSays) {
     }
   EXPECT_GE(same, got.hit.size() - 6);
   EXPECT_LT(mirrored, got.hit.size() / 2);  // the test would not see a flip otherwise
+}
+
+TEST(OpenGl, CamerasWithinAndOutsideTheBandSeeAsTheScalarKernel) {
+  SKIP_WITHOUT_OPENGL();
+  test::expect_band_views_as_scalar(opengl());
+}
+
+TEST(OpenGlShader, ACameraWithinTheBandGetsAShaderWithoutTheEntryIntoIt) {
+  const Scene& scene = test::gallery_scene("l_shape");
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
+  const float height = tables.params.height;
+  EXPECT_TRUE(kernel::within_band(tables, Vec3(0.0, 0.0, 0.0)));
+  EXPECT_TRUE(kernel::within_band(tables, Vec3(0.0, 0.0, height)));
+  EXPECT_FALSE(kernel::within_band(tables, Vec3(0.0, 0.0, std::nextafter(height, 1e9f))));
+  EXPECT_FALSE(kernel::within_band(tables, Vec3(0.0, 0.0, -1e-6)));
+  const std::string from_band = "#define FLATMARCH_FROM_BAND";
+  EXPECT_NE(kernel::scene_fragment_shader(tables, false, true).find(from_band), std::string::npos);
+  EXPECT_NE(kernel::scene_compute_shader(tables, false, true).find(from_band), std::string::npos);
+  EXPECT_EQ(kernel::scene_fragment_shader(tables).find(from_band), std::string::npos);
+  EXPECT_EQ(kernel::scene_fragment_shader(tables, true, true).find(from_band), std::string::npos)
+      << "a probe ray may start anywhere";
 }
 
 TEST(OpenGlShader, BakesTheTablesAndSpecialisesOnTheFeatures) {

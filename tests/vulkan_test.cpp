@@ -14,6 +14,7 @@
 #include "backends/vulkan/spirv.hpp"
 #include "kernels/scene_shader.hpp"
 #include "kernels/shader_log.hpp"
+#include "tests/band_views.hpp"
 #include "tests/gallery.hpp"
 #include "tests/oracle_compare.hpp"
 #include "tests/process.hpp"
@@ -93,6 +94,11 @@ TEST(Vulkan, TraceMatchesTheScalarKernelsSteps) {
     for (size_t k = 0; k < a.events.size(); ++k)
       EXPECT_EQ(test::describe(b.events[k]), test::describe(a.events[k]));
   }
+}
+
+TEST(Vulkan, CamerasWithinAndOutsideTheBandSeeAsTheScalarKernel) {
+  SKIP_WITHOUT_VULKAN();
+  test::expect_band_views_as_scalar(vulkan());
 }
 
 TEST(Vulkan, TraceKeepsAtMostMaxEventsAndCountsTheRest) {

@@ -88,10 +88,11 @@ RenderTargets::~RenderTargets() {
   gl_.DeleteFramebuffers(1, &framebuffer_);
 }
 
-KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace)
+KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace,
+                             bool from_band)
     : gl_(gl), trace_(trace) {
   program_ = link_program(gl, kernel::kFullScreenVertexShader,
-                          kernel::scene_fragment_shader(tables, trace));
+                          kernel::scene_fragment_shader(tables, trace, from_band));
   polygon_ = gl.GetUniformLocation(program_, "u_polygon");
   from_ = gl.GetUniformLocation(program_, "u_from");
   forward_ = gl.GetUniformLocation(program_, "u_forward");

@@ -44,8 +44,10 @@ class RenderTargets {
 // The compiled kernel of one scene and one set of march parameters (both baked in).
 class KernelProgram {
  public:
-  // `trace`: the variant that marches one probe ray and records its events.
-  KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace);
+  // `trace`: the variant that marches one probe ray and records its events. `from_band`: one for
+  // cameras within the band only (kernel::scene_fragment_shader).
+  KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace,
+                bool from_band = false);
   ~KernelProgram();
   KernelProgram(const KernelProgram&) = delete;
   KernelProgram& operator=(const KernelProgram&) = delete;

@@ -32,14 +32,15 @@ struct OpenGlBackend::Context {
 
   const gl::Api& gl() const { return gl_context->api(); }
 
-  gl::KernelProgram& program(const kernel::SceneTables<float>& tables, bool trace) {
-    std::string key = kernel::scene_fragment_shader(tables, trace);
+  gl::KernelProgram& program(const kernel::SceneTables<float>& tables, bool trace,
+                             bool from_band = false) {
+    std::string key = kernel::scene_fragment_shader(tables, trace, from_band);
     auto it = std::find_if(programs.begin(), programs.end(),
                            [&](const auto& p) { return p.first == key; });
     if (it == programs.end()) {
       if (programs.size() == kProgramCache) programs.erase(programs.begin());
       programs.emplace_back(std::move(key),
-                            std::make_unique<gl::KernelProgram>(gl(), tables, trace));
+                            std::make_unique<gl::KernelProgram>(gl(), tables, trace, from_band));
       it = programs.end() - 1;
     } else {
       std::rotate(it, it + 1, programs.end());  // now the most recently used
@@ -150,7 +151,8 @@ Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width,
   const gl::Context::Current current(*c.gl_context);
   const gl::Api& gl = c.gl();
   gl.GetError();  // a clean slate for the check below
-  gl::KernelProgram& program = c.program(tables, false);
+  gl::KernelProgram& program =
+      c.program(tables, false, kernel::within_band(tables, camera.position));
   if (!c.targets || c.targets->width() != width || c.targets->height() != height) {
     c.targets.reset();
     c.targets = std::make_unique<gl::RenderTargets>(gl, width, height);

@@ -277,8 +277,9 @@ struct VulkanBackend::Context {
     return vk::raii::Pipeline(device, nullptr, info);
   }
 
-  CachedPipeline& pipeline(const kernel::SceneTables<float>& tables, bool trace) {
-    std::string key = kernel::scene_compute_shader(tables, trace);
+  CachedPipeline& pipeline(const kernel::SceneTables<float>& tables, bool trace,
+                           bool from_band = false) {
+    std::string key = kernel::scene_compute_shader(tables, trace, from_band);
     auto it = std::find_if(pipelines.begin(), pipelines.end(),
                            [&](const CachedPipeline& p) { return p.source == key; });
     if (it == pipelines.end()) {
@@ -584,7 +585,8 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const ValidationCheck check(validation_);
   const std::lock_guard<std::mutex> lock(c.mutex);
-  Context::CachedPipeline& cached = c.pipeline(tables, false);
+  Context::CachedPipeline& cached =
+      c.pipeline(tables, false, kernel::within_band(tables, camera.position));
   const vk::Pipeline pipeline = *cached.pipeline;
   c.reserve_pixels(bytes);
 
