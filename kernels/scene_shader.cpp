@@ -1,6 +1,8 @@
 #include "kernels/scene_shader.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <numeric>
 
 #include "kernels/shader_source.hpp"
 
@@ -85,6 +87,7 @@ layout(push_constant) uniform Constants {
   vec4 up;
   vec4 scale;
   ivec4 frame;  // width, height, first row, polygon
+  ivec4 order;  // x: the stride of the rows of workgroups (row_stride)
 } pc;
 
 #ifdef FLATMARCH_TRACE
@@ -97,7 +100,10 @@ void main() {
 layout(local_size_x = TILE, local_size_y = TILE) in;
 layout(std430, binding = 5) writeonly buffer Pixels { vec4 pixels[]; };
 void main() {
-  ivec2 p = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, pc.frame.z);
+  // The workgroups' rows draw the band's rows of tiles in a spread order (row_stride).
+  uint row = (gl_WorkGroupID.y * uint(pc.order.x)) % gl_NumWorkGroups.y;
+  ivec2 p = ivec2(ivec2(gl_WorkGroupID.x, row) * TILE + ivec2(gl_LocalInvocationID.xy)) +
+            ivec2(0, pc.frame.z);
   if (p.x < pc.frame.x && p.y < pc.frame.y) {
     vec2 size = vec2(pc.frame.xy);
     float u = (2.0 * (float(p.x) + 0.5) / size.x - 1.0) * pc.scale.x;
@@ -115,6 +121,13 @@ void main() {
 )glsl";
 
 }  // namespace
+
+int row_stride(int rows) {
+  if (rows <= 2) return 1;
+  int stride = static_cast<int>(std::lround(0.6180339887498949 * rows));
+  while (std::gcd(stride, rows) != 1) ++stride;
+  return stride;
+}
 
 std::string baked_params(const Tables<float>::KernelParams& p) {
   // In the order of KernelParams' fields (kernels/tables.glsl).

@@ -5,6 +5,7 @@
 // skip, visibly, where there is none.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
@@ -56,6 +57,21 @@ TEST(VulkanShader, BakesTheTablesAsPlainArraysAndSpecialises) {
   EXPECT_EQ(source.find("#define FLATMARCH_TRACE"), std::string::npos);
   EXPECT_NE(kernel::scene_compute_shader(tables, true).find("#define FLATMARCH_TRACE"),
             std::string::npos);
+}
+
+TEST(VulkanShader, RowsOfWorkgroupsDrawEveryRowOnceInASpreadOrder) {
+  for (int rows = 1; rows <= 300; ++rows) {
+    const int stride = kernel::row_stride(rows);
+    std::vector<int> drawn(static_cast<size_t>(rows), 0);
+    for (int k = 0; k < rows; ++k) ++drawn[static_cast<size_t>(k * stride % rows)];
+    EXPECT_EQ(std::count(drawn.begin(), drawn.end(), 1), rows) << rows << " rows, stride " << stride;
+    if (rows < 8) continue;
+    // The first half of the workgroups (one of two threads' runs) draws rows from both halves
+    // of the band, about as many from each.
+    int top = 0;
+    for (int k = 0; k < rows / 2; ++k) top += k * stride % rows < rows / 2;
+    EXPECT_NEAR(top, rows / 4, rows / 8 + 1) << rows << " rows, stride " << stride;
+  }
 }
 
 TEST(VulkanShader, GlslangErrorsNameTheBrokenLine) {

@@ -599,21 +599,23 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
       .right = glm::vec4(basis.right, 0.0f),
       .up = glm::vec4(basis.up, 0.0f),
       .scale = glm::vec4(basis.aspect * basis.tan_half_fov, basis.tan_half_fov, 0.0f, 0.0f),
-      .frame = glm::ivec4(width, height, 0, camera.polygon)};
+      .frame = glm::ivec4(width, height, 0, camera.polygon),
+      .order = glm::ivec4(1, 0, 0, 0)};  // each band's, below
   BandPacer bands(cached.pace, width, height, kernel::kComputeTile);
   for (int row = 0, rows = 0; row < height; row += rows) {
     rows = bands.rows(row);
     const bool last = row + rows == height;
     const auto start = std::chrono::steady_clock::now();
+    const auto tile_rows =
+        static_cast<uint32_t>((rows + kernel::kComputeTile - 1) / kernel::kComputeTile);
     constants.frame.z = row;
+    constants.order.x = kernel::row_stride(static_cast<int>(tile_rows));
     c.run([&](const vk::raii::CommandBuffer& cmd) {
       cmd.bindPipeline(vk::PipelineBindPoint::eCompute, pipeline);
       cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *c.layout, 0, *c.set, {});
       cmd.pushConstants<kernel::ComputeConstants>(*c.layout, vk::ShaderStageFlagBits::eCompute, 0,
                                                   constants);
-      cmd.dispatch(groups_x,
-                   static_cast<uint32_t>((rows + kernel::kComputeTile - 1) / kernel::kComputeTile),
-                   1);
+      cmd.dispatch(groups_x, tile_rows, 1);
       if (!last) return;
       // The shader's writes, made visible to the host (through a copy to staging where the
       // pixels are not host-visible).
@@ -678,7 +680,8 @@ Trace VulkanBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
                                            .right = glm::vec4(0.0f),
                                            .up = glm::vec4(0.0f),
                                            .scale = glm::vec4(0.0f),
-                                           .frame = glm::ivec4(1, 1, 0, ray.polygon)};
+                                           .frame = glm::ivec4(1, 1, 0, ray.polygon),
+                                           .order = glm::ivec4(1, 0, 0, 0)};
   c.run([&](const vk::raii::CommandBuffer& cmd) {
     // (The host's write of the header is visible to the device: the submission orders it.)
     cmd.bindPipeline(vk::PipelineBindPoint::eCompute, pipeline);
