@@ -64,7 +64,8 @@ TEST(VulkanShader, RowsOfWorkgroupsDrawEveryRowOnceInASpreadOrder) {
     const int stride = kernel::row_stride(rows);
     std::vector<int> drawn(static_cast<size_t>(rows), 0);
     for (int k = 0; k < rows; ++k) ++drawn[static_cast<size_t>(k * stride % rows)];
-    EXPECT_EQ(std::count(drawn.begin(), drawn.end(), 1), rows) << rows << " rows, stride " << stride;
+    EXPECT_EQ(std::count(drawn.begin(), drawn.end(), 1), rows)
+        << rows << " rows, stride " << stride;
     if (rows < 8) continue;
     // The first half of the workgroups (one of two threads' runs) draws rows from both halves
     // of the band, about as many from each.
