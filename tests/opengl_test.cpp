@@ -12,13 +12,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "backends/bands.hpp"
 #include "backends/opengl/gl_kernel.hpp"
 #include "backends/opengl/opengl.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "kernels/scene_shader.hpp"
-#include "tests/band_views.hpp"
 #include "tests/gallery.hpp"
+#include "tests/gpu_backend_checks.hpp"
 #include "tests/opengl_backend.hpp"
 #include "tests/oracle_compare.hpp"
 #include "tests/process.hpp"
@@ -62,21 +61,7 @@ TEST(OpenGl, RefusesFloat64AndSaysWhy) {
 
 TEST(OpenGl, ReportsProgressInBandsToTheEnd) {
   SKIP_WITHOUT_OPENGL();
-  const Scene& scene = test::gallery_scene("torus");
-  // March parameters of this test's own: a program's first frame (BandPacer).
-  MarchParams params;
-  params.eps = 1.25e-4;
-  std::vector<double> seen;
-  opengl().render(scene, scene.camera, 32, 200, params, [&](double f) { seen.push_back(f); });
-  ASSERT_GE(seen.size(), 2u);
-  EXPECT_DOUBLE_EQ(seen.front(), BandPacer::kFirstBandRows / 200.0);
-  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
-  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
-  seen.clear();  // the next frame: bands by the first frame's pace, to the end
-  opengl().render(scene, scene.camera, 32, 200, params, [&](double f) { seen.push_back(f); });
-  ASSERT_GE(seen.size(), 1u);
-  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
-  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+  test::expect_progress_in_bands(opengl());
 }
 
 TEST(OpenGl, ImageRowsAreTopDownAsDesignSays) {

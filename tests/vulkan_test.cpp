@@ -10,13 +10,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "backends/bands.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "backends/vulkan/spirv.hpp"
 #include "kernels/scene_shader.hpp"
 #include "kernels/shader_log.hpp"
-#include "tests/band_views.hpp"
 #include "tests/gallery.hpp"
+#include "tests/gpu_backend_checks.hpp"
 #include "tests/oracle_compare.hpp"
 #include "tests/process.hpp"
 #include "tests/vulkan_backend.hpp"
@@ -145,21 +144,7 @@ TEST(Vulkan, RefusesFloat64AndSaysWhy) {
 
 TEST(Vulkan, ReportsProgressInBandsToTheEnd) {
   SKIP_WITHOUT_VULKAN();
-  const Scene& scene = test::gallery_scene("torus");
-  // March parameters of this test's own: a program's first frame (BandPacer).
-  MarchParams params;
-  params.eps = 1.25e-4;
-  std::vector<double> seen;
-  vulkan().render(scene, scene.camera, 32, 200, params, [&](double f) { seen.push_back(f); });
-  ASSERT_GE(seen.size(), 2u);
-  EXPECT_DOUBLE_EQ(seen.front(), BandPacer::kFirstBandRows / 200.0);
-  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
-  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
-  seen.clear();  // the next frame: bands by the first frame's pace, to the end
-  vulkan().render(scene, scene.camera, 32, 200, params, [&](double f) { seen.push_back(f); });
-  ASSERT_GE(seen.size(), 1u);
-  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
-  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+  test::expect_progress_in_bands(vulkan());
 }
 
 // The hit AOV's pixels that differ from the scalar backend's.

@@ -1,15 +1,40 @@
-// A GPU backend's frames from cameras within and outside the band [0, height]: the shader of a
-// camera within it leaves out the entry into the band (kernel::scene_fragment_shader's
-// `from_band`), and one outside keeps it. Both must see what the scalar kernel sees.
+// What the OpenGL and Vulkan test programs hold both GPU backends to, written once.
 #pragma once
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <vector>
+
+#include "backends/bands.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "tests/gallery.hpp"
 
 namespace flatmarch::test {
 
+// A frame is drawn in bands (BandPacer): the first frame of a program starts with
+// kFirstBandRows, a later one goes by the first one's pace; progress rises to 1 either way.
+inline void expect_progress_in_bands(const Backend& backend) {
+  const Scene& scene = gallery_scene("torus");
+  // March parameters of this test's own: a program's first frame.
+  MarchParams params;
+  params.eps = 1.25e-4;
+  std::vector<double> seen;
+  backend.render(scene, scene.camera, 32, 200, params, [&](double f) { seen.push_back(f); });
+  ASSERT_GE(seen.size(), 2u);
+  EXPECT_DOUBLE_EQ(seen.front(), BandPacer::kFirstBandRows / 200.0);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+  seen.clear();  // the next frame: bands by the first frame's pace, to the end
+  backend.render(scene, scene.camera, 32, 200, params, [&](double f) { seen.push_back(f); });
+  ASSERT_GE(seen.size(), 1u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+}
+
+// Frames from cameras within and outside the band [0, height]: the shader of a camera within it
+// leaves out the entry into the band (kernel::scene_fragment_shader's `from_band`), and one
+// outside keeps it. Both must see what the scalar kernel sees.
 inline void expect_band_views_as_scalar(const Backend& backend) {
   for (const char* name : {"l_shape", "cube"}) {
     const Scene& scene = gallery_scene(name);
