@@ -37,8 +37,7 @@ void simd_frame(benchmark::State& state, const Scene* scene, MarchParams params,
     benchmark::DoNotOptimize(frame.rgb.data());
   }
   bench::frame_counters(state, frame);
-  state.counters["lane_utilisation"] =
-      static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
+  reports::simd_counters(state, simd, *scene, scene->camera, kWidth, kHeight, params, frame, lanes);
   state.counters["lanes"] = simd.lanes();
 }
 

@@ -125,11 +125,13 @@ def ranking_section(results):
                f'{b["passed"]}/{b["cases"]}' + (f' ({b["errors"]} errors)' if b["errors"] else "")]
         for m in methods:
             mm = b["methods"].get(m)
-            row.append(f'{mrays(mm["rays_per_s"])} ({int(mm["passed"])}/{int(mm["cases"])})' if mm else "-")
+            peak = f', {pct(mm["of_peak"])} of peak' if mm and "of_peak" in mm else ""
+            row.append(f'{mrays(mm["rays_per_s"])} ({int(mm["passed"])}/{int(mm["cases"])}{peak})' if mm else "-")
         row.append(b["best_method"] or "-")
         rows.append(row)
     parts.append("<p>Backends ranked: those that passed every conformance case first, then by the geometric "
-                 "mean of rays per second over every scene and method. Per method: Mrays/s (cases passed). "
+                 "mean of rays per second over every scene and method. Per method: Mrays/s (cases passed; for the "
+                 "SIMD backend, the geometric mean of how much of this CPU's peak its frames reach, see Steps). "
                  "A GPU backend names the device it ran on; <i>software</i> marks a rasteriser running on the "
                  "CPU (Mesa's llvmpipe and lavapipe), whose speed says nothing of a GPU's.</p>")
     parts.append(table(["rank", "backend", "device", "Mrays/s", "conform"] + [f"{m} Mrays/s" for m in methods] +
@@ -216,15 +218,24 @@ def steps_heatmap_section(cases):
     ax.set_xticks(range(len(columns)), [f"{b}\n{m}" for b, m in columns], fontsize=7, rotation=90)
     fig.colorbar(im, ax=ax, label="mean steps per ray (log)")
     ax.set_title("Kernel steps per ray")
-    lanes = {(c["scene"], c["method"]): c["counters"]["lane_utilisation"] for c in cases
-             if "lane_utilisation" in c.get("counters", {})}
+    simd = {(c["scene"], c["method"]): c["counters"] for c in cases
+            if "lane_utilisation" in c.get("counters", {})}
     lane_table = ""
-    if lanes:
-        methods = [m for m in ["sphere", "relaxed", "analytic"] if any(k[1] == m for k in lanes)]
+    if simd:
+        methods = [m for m in ["sphere", "relaxed", "analytic"] if any(k[1] == m for k in simd)]
+
+        def cell(counters):
+            text = pct(counters["lane_utilisation"]) + " lanes"
+            if "of_peak" in counters:
+                text += f' · {pct(counters["of_peak"])} of peak'
+            return text
         lane_table = ("<p>SIMD lane utilisation: the share of packet lanes doing work, over every step of every "
-                      "packet (rays of a packet that finish early, or step apart, leave lanes idle).</p>" +
+                      "packet (rays of a packet that finish early, or step apart, leave lanes idle); and how close "
+                      "to what this CPU can do the frame runs: its kernel steps a second over the peak, the steps a "
+                      "second of one room's step on full packets on every core (no lane idle, nothing to shade or "
+                      "write, the tables in cache).</p>" +
                       table(["scene"] + methods,
-                            [[s] + [pct(lanes[(s, m)]) if (s, m) in lanes else "-" for m in methods] for s in scenes]))
+                            [[s] + [cell(simd[(s, m)]) if (s, m) in simd else "-" for m in methods] for s in scenes]))
     return ("<h2 id=steps>Steps per ray</h2><p>The mean number of kernel iterations per ray of the timed frames, per "
             "scene, backend and method: the cost the backends share; backends of one method should agree.</p>"
             + figure_html(fig, "steps heatmap") + lane_table)

@@ -113,8 +113,7 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
               if (simd) {
                 simd::LaneCounts lanes;
                 simd->render_counted(scene, camera, width, height, params, {}, lanes);
-                state.counters["lane_utilisation"] =
-                    static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
+                simd_counters(state, *simd, scene, camera, width, height, params, f, lanes);
               }
             } catch (const std::exception& e) {
               state.SkipWithError(e.what());
@@ -142,6 +141,21 @@ void frame_counters(benchmark::State& state, const Frame& frame) {
   state.counters["out_of_steps"] =
       static_cast<double>(std::count(frame.hit.begin(), frame.hit.end(), float(kHitMaxSteps))) /
       pixels;
+}
+
+void simd_counters(benchmark::State& state, const SimdBackend& simd, const Scene& scene,
+                   const Camera& camera, int width, int height, const MarchParams& params,
+                   const Frame& frame, const simd::LaneCounts& lanes) {
+  state.counters["lane_utilisation"] =
+      static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
+  const double steps = std::accumulate(frame.steps.begin(), frame.steps.end(), 0.0);
+  state.counters["steps_per_s"] =
+      benchmark::Counter(steps, benchmark::Counter::kIsIterationInvariantRate);
+  const double peak = simd.peak_lane_steps(scene, camera, width, height, params);
+  if (peak <= 0.0) return;  // no step to time (SimdBackend::peak_lane_steps)
+  state.counters["peak_steps_per_s"] = peak;
+  state.counters["of_peak"] =
+      benchmark::Counter(steps / peak, benchmark::Counter::kIsIterationInvariantRate);
 }
 
 json run_registered_benchmarks(const std::function<void(const std::string&)>& on_run) {

@@ -13,6 +13,7 @@
 #include <benchmark/benchmark.h>
 
 #include "backends/backend.hpp"
+#include "backends/simd/simd.hpp"
 #include "conformance/suite.hpp"
 
 namespace flatmarch::reports {
@@ -61,10 +62,10 @@ nlohmann::json run_registered_benchmarks(const std::function<void(const std::str
 
 // Registers one timed case, BACKEND/METHOD/SCENE/WxH: frames of the scene's camera, after one
 // untimed frame (GPU backends compile the scene's program then); counters rays_per_s,
-// steps_mean, steps_p99, crossings_mean, out_of_steps and, for the SIMD backend, lane_utilisation;
-// a GPU backend's runs are labelled with its device (device_label).
-// `last`, when given, receives the last frame. Repetitions and min_time of 0 leave them to
-// Google Benchmark's flags (--benchmark_repetitions, --benchmark_min_time).
+// steps_mean, steps_p99, crossings_mean, out_of_steps and, for the SIMD backend, lane_utilisation,
+// steps_per_s, peak_steps_per_s and of_peak (simd_counters); a GPU backend's runs are labelled with
+// its device (device_label). `last`, when given, receives the last frame. Repetitions and min_time
+// of 0 leave them to Google Benchmark's flags (--benchmark_repetitions, --benchmark_min_time).
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
                               const MarchParams& params, int width, int height, int repetitions,
                               double min_time, Frame* last = nullptr, const std::string& name = "");
@@ -73,6 +74,16 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
 // figures of the frame: steps_mean, steps_p99, crossings_mean, out_of_steps (share of rays that
 // reached max_steps).
 void frame_counters(benchmark::State& state, const Frame& frame);
+
+// The SIMD backend's counters of a timed frame: lane_utilisation (active lanes over lanes, of
+// `lanes`), steps_per_s (the frame's steps, summed over its rays, a second: a rate over the
+// iterations), peak_steps_per_s (SimdBackend::peak_lane_steps: one room's step on full packets
+// on all its threads) and of_peak, the share of that peak the frame's steps reach: how close to
+// what this CPU can do the backend runs (idle lanes, shading, pixel writes and scheduling make the
+// rest).
+void simd_counters(benchmark::State& state, const SimdBackend& simd, const Scene& scene,
+                   const Camera& camera, int width, int height, const MarchParams& params,
+                   const Frame& frame, const simd::LaneCounts& lanes);
 
 // The name register_frame_benchmark gives.
 std::string case_name(const std::string& backend, Method method, const std::string& scene,

@@ -90,6 +90,8 @@ json rank_backends(const json& matrix) {
     double log_rays = 0.0;
     int timed = 0;
     std::map<std::string, std::array<double, 4>> methods;  // cases, passed, log rays, timed
+    // The SIMD backend's share of its peak (counter of_peak), per method: sum of logs, cases.
+    std::map<std::string, std::array<double, 2>> of_peak;
   };
   std::map<std::string, Tally> tallies;
   std::map<std::string, json> devices;  // of the GPU backends
@@ -115,6 +117,11 @@ json rank_backends(const json& matrix) {
       ++t.timed;
       m[2] += l;
       m[3] += 1;
+      if (const double p = c["counters"].value("of_peak", 0.0); p > 0.0) {
+        auto& share = t.of_peak[c["method"].get<std::string>()];
+        share[0] += std::log(p);
+        share[1] += 1;
+      }
     }
   }
   json ranking = json::array();
@@ -128,6 +135,8 @@ json rank_backends(const json& matrix) {
       const bool conforms = m[1] == m[0];
       methods[name] = {
           {"cases", m[0]}, {"passed", m[1]}, {"rays_per_s", rays}, {"conforms", conforms}};
+      if (const auto share = t.of_peak.find(name); share != t.of_peak.end())
+        methods[name]["of_peak"] = std::exp(share->second[0] / share->second[1]);
       if (conforms && rays > best_rays) {
         best = name;
         best_rays = rays;

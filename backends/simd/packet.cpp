@@ -225,8 +225,8 @@ class Marcher {
 
   // The start of march.glsl's march(): the lanes of `m` begin a ray from (fx, fy, fz) in
   // `polygon` along (dx, dy, dz). The other lanes are left as they are.
-  FLATMARCH_PACKET_INLINE void start(Packet& r, Relaxation& x, Segment& seg, M m, int polygon, V fx, V fy, V fz,
-                        V dx, V dy, V dz) const {
+  FLATMARCH_PACKET_INLINE void start(Packet& r, Relaxation& x, Segment& seg, M m, int polygon, V fx,
+                                     V fy, V fz, V dx, V dy, V dz) const {
     r.polygon = Select(m, SplatI(polygon), r.polygon);
     r.ox = Select(m, fx, r.ox);
     r.oy = Select(m, fy, r.oy);
@@ -260,7 +260,8 @@ class Marcher {
   // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
   // of the rays that have taken max_steps. A step runs in passes of up to kRoomsPerPass rooms
   // (usually one pass); the rays a pass moves to another room are already out of `pending`.
-  FLATMARCH_PACKET_INLINE void step(Packet& r, Relaxation& x, Segment& seg, LaneCounts& lanes) const {
+  FLATMARCH_PACKET_INLINE void step(Packet& r, Relaxation& x, Segment& seg,
+                                    LaneCounts& lanes) const {
     const M active = hn::Not(r.done);
     r.steps = Select(active, r.steps + SplatI(1), r.steps);
     std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
@@ -303,8 +304,8 @@ class Marcher {
 
   // march.glsl's shade(): the linear colour of finished rays. transmittance[c] is
   // (1 - wall_tint)^c as shade computes it, for the first crossing counts.
-  FLATMARCH_PACKET_INLINE void shade(const Packet& r, const std::vector<float>& transmittance, V& red, V& green,
-                        V& blue) const {
+  FLATMARCH_PACKET_INLINE void shade(const Packet& r, const std::vector<float>& transmittance,
+                                     V& red, V& green, V& blue) const {
     V cr = Splat(params_.background.x), cg = Splat(params_.background.y);
     V cb = Splat(params_.background.z);
     const M object = AtLeastZero(r.hit);
@@ -352,8 +353,8 @@ class Marcher {
   bool has(uint feature) const { return (features_ & feature) != 0u; }
 
   // Records an event of lane 0 (the one a trace follows) when it is in `m`.
-  FLATMARCH_PACKET_INLINE void record(M m, int kind, VI polygon, VI edge, int to_polygon, int to_edge, VI hit,
-                         const Packet& r) const {
+  FLATMARCH_PACKET_INLINE void record(M m, int kind, VI polygon, VI edge, int to_polygon,
+                                      int to_edge, VI hit, const Packet& r) const {
     if (!events_ || static_cast<int>(events_->size()) >= max_events_ ||
         hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1))))
       return;
@@ -760,7 +761,8 @@ class Marcher {
 
   // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `rooms`.
   template <bool kOneRoom>
-  FLATMARCH_PACKET_INLINE void sphere_step(Packet& r, Relaxation& x, M m, const Rooms& rooms) const {
+  FLATMARCH_PACKET_INLINE void sphere_step(Packet& r, Relaxation& x, M m,
+                                           const Rooms& rooms) const {
     const WallDistance wall = wall_distance<kOneRoom>(rooms, r.ox, r.oy);
     const SolidDistance solid = nearest_solid(rooms, r.ox, r.oy, r.oz);
     const V radius = hn::Min(wall.d, solid.d);
@@ -817,7 +819,8 @@ class Marcher {
 
   // One iteration of the analytic method for the rays of `m`, in `rooms`.
   template <bool kOneRoom>
-  FLATMARCH_PACKET_INLINE void analytic_step(Packet& r, Segment& seg, M m, const Rooms& rooms) const {
+  FLATMARCH_PACKET_INLINE void analytic_step(Packet& r, Segment& seg, M m,
+                                             const Rooms& rooms) const {
     const M unknown = hn::AndNot(seg.known, m);
     if (Any(unknown)) {
       const Exit x = exit_edge<kOneRoom>(unknown, rooms, r.ox, r.oy, r.dx, r.dy);
@@ -1033,6 +1036,60 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   }
 }
 
+// The rays of the frame's central tile (a packet's worth, clamped to the frame), started from the
+// camera.
+void CentralPacket(const PacketJob& job, const Marcher& marcher, Packet& r, Relaxation& x,
+                   Segment& seg) {
+  const TileShape tile = tile_shape(PacketLanes());
+  const CameraBasis<float>& c = job.basis;
+  constexpr size_t kMax = hn::MaxLanes(DI());
+  std::array<int32_t, kMax> pixel_i{}, pixel_j{};
+  for (size_t l = 0; l < hn::Lanes(D()); ++l) {
+    const int i = job.width / 2 - tile.width / 2 + static_cast<int>(l) % tile.width;
+    const int j = job.height / 2 - tile.height / 2 + static_cast<int>(l) / tile.width;
+    pixel_i[l] = std::clamp(i, 0, job.width - 1);
+    pixel_j[l] = std::clamp(j, 0, job.height - 1);
+  }
+  const DI di;
+  const V px = hn::ConvertTo(D(), hn::LoadU(di, pixel_i.data())) + Splat(0.5f);
+  const V py = hn::ConvertTo(D(), hn::LoadU(di, pixel_j.data())) + Splat(0.5f);
+  const V u =
+      ((Splat(2.0f) * px / Splat(static_cast<float>(job.width)) - Splat(1.0f)) * Splat(c.aspect)) *
+      Splat(c.tan_half_fov);
+  const V v = (Splat(1.0f) - Splat(2.0f) * py / Splat(static_cast<float>(job.height))) *
+              Splat(c.tan_half_fov);
+  const V dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
+  const V dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
+  const V dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
+  Marcher::clear(r, x, seg);
+  marcher.start(r, x, seg, hn::Not(None()), job.polygon, Splat(job.from.x), Splat(job.from.y),
+                Splat(job.from.z), dx, dy, dz);
+}
+
+// One room's step on a full packet, `repeats` times: the central tile's rays (CentralPacket),
+// each time from their start, take one step. Returns the lanes that stepped, summed: the
+// lane-steps a packet takes when nothing leaves a lane idle (a ray that starts done does not
+// count).
+int64_t RoomSteps(const PacketJob& job, int64_t repeats) {
+  const Marcher marcher(*job.tables, job.edge_extra, nullptr, 0);
+  Packet start, r;
+  Relaxation start_x, x;
+  Segment start_seg, seg;
+  CentralPacket(job, marcher, start, start_x, start_seg);
+  LaneCounts lanes;
+  V sum = Splat(0.0f);  // of the steps' results, so that none is left out as unused
+  for (int64_t k = 0; k < repeats; ++k) {
+    r = start;
+    x = start_x;
+    seg = start_seg;
+    marcher.step(r, x, seg, lanes);
+    sum = sum + r.t + r.ox + r.oy + r.oz;
+  }
+  volatile float sink = hn::GetLane(sum);
+  static_cast<void>(sink);
+  return lanes.active;
+}
+
 // Follows one ray in lane 0 of a packet, recording at most `max_events` of its events; returns
 // its steps.
 int TraceRay(const PacketJob& job, const Ray& ray, int max_events,
@@ -1073,6 +1130,7 @@ PacketJob packet_job(const kernel::SceneTables<float>& tables) {
 HWY_EXPORT(PacketLanes);
 HWY_EXPORT(MarchPackets);
 HWY_EXPORT(TraceRay);
+HWY_EXPORT(RoomSteps);
 
 int64_t compiled_targets() {
   return HWY_TARGETS;
@@ -1086,7 +1144,7 @@ PacketCode packet_code(int64_t target) {
   if (target != 0) hwy::SetSupportedTargetsForTest(target);
   hwy::GetChosenTarget().Update(hwy::SupportedTargets());
   PacketCode code{&HWY_DYNAMIC_DISPATCH(PacketLanes), &HWY_DYNAMIC_DISPATCH(MarchPackets),
-                  &HWY_DYNAMIC_DISPATCH(TraceRay)};
+                  &HWY_DYNAMIC_DISPATCH(TraceRay), &HWY_DYNAMIC_DISPATCH(RoomSteps)};
   if (target != 0) {
     hwy::SetSupportedTargetsForTest(0);
     hwy::GetChosenTarget().Update(hwy::SupportedTargets());

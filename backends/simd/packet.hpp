@@ -59,6 +59,12 @@ struct PacketCode {
   // steps.
   int (*trace)(const PacketJob& job, const Ray& ray, int max_events,
                std::vector<kernel::KernelEvent>* events);
+  // One room's step on a full packet, `repeats` times: the packet of the frame's central tile of
+  // pixels (a packet's worth of rays from the camera, in its room), each time from the rays'
+  // start, takes one step. Returns the lane-steps taken (lanes times repeats where no ray
+  // starts done). Timed, it is the most lane-steps a second a core makes on this scene and
+  // method: no lane idle, no pixel to shade or write, the tables in cache.
+  int64_t (*room_steps)(const PacketJob& job, int64_t repeats);
 };
 
 // The Highway targets (HWY_SSE4, HWY_AVX2, ...) packet.cpp was compiled for.

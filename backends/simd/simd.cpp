@@ -8,8 +8,11 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <mutex>
+#include <numeric>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include "backends/kernel_trace.hpp"
@@ -165,6 +168,35 @@ Frame SimdBackend::render_counted(const Scene& scene, const Camera& camera, int 
   lanes.active += active;
   lanes.slots += slots;
   return frame;
+}
+
+double SimdBackend::peak_lane_steps(const Scene& scene, const Camera& camera, int width, int height,
+                                    const MarchParams& params, double seconds) const {
+  check_precision(params);
+  const simd::PacketCode packets = code();
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+  Frame none;  // nothing is drawn
+  const simd::PacketJob job = frame_job(tables, camera, width, height, none);
+  const int threads = options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
+  // One thread a core, each stepping its own packet for `seconds`: what the cores make at once.
+  std::vector<double> rates(static_cast<size_t>(threads), 0.0);
+  const auto run = [&](size_t k) {
+    const auto start = std::chrono::steady_clock::now();
+    int64_t steps = 0;
+    double elapsed = 0.0;
+    do {
+      const int64_t more = packets.room_steps(job, 256);
+      if (more == 0) return;  // every ray of the packet starts done: no step to time
+      steps += more;
+      elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    } while (elapsed < seconds);
+    rates[k] = static_cast<double>(steps) / elapsed;
+  };
+  std::vector<std::thread> pool;
+  for (size_t k = 1; k < rates.size(); ++k) pool.emplace_back(run, k);
+  run(0);
+  for (std::thread& t : pool) t.join();
+  return std::accumulate(rates.begin(), rates.end(), 0.0);
 }
 
 Trace SimdBackend::trace(const Scene& scene, const Ray& ray, const MarchParams& params,

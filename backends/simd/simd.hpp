@@ -39,6 +39,12 @@ class SimdBackend final : public Backend {
   Frame render_counted(const Scene& scene, const Camera& camera, int width, int height,
                        const MarchParams& params, const Progress& progress,
                        simd::LaneCounts& lanes) const;
+  // The most lane-steps a second it makes on this scene, camera and method, on all its threads:
+  // each thread times one room's step on a full packet (simd::PacketCode::room_steps) for about
+  // `seconds`. A frame's steps a second over this is how close to this CPU's limit it runs; 0
+  // when the rays of the packet timed (the frame's central tile) all end as they start.
+  double peak_lane_steps(const Scene& scene, const Camera& camera, int width, int height,
+                         const MarchParams& params, double seconds = 0.05) const;
   // The instruction set it runs (--isa's name) and its lanes per packet; "" and 0 if unavailable.
   std::string isa() const { return isa_; }
   int lanes() const;

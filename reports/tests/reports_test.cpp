@@ -186,6 +186,20 @@ TEST(Ranking, ConformingBackendsFirstThenBySpeed) {
   EXPECT_TRUE(rec["parameters"].empty());  // no sweep: select falls back to the defaults
 }
 
+TEST(Ranking, SimdShareOfPeakIsTheGeometricMeanPerMethod) {
+  json cases = json::array();
+  for (const auto& [scene, share] : {std::pair{"x", 0.2}, std::pair{"y", 0.8}}) {
+    cases.push_back(matrix_case("simd", "sphere", scene, 1e6, true, 10));
+    cases.back()["counters"]["of_peak"] = share;
+    cases.push_back(matrix_case("scalar", "sphere", scene, 1e5, true, 10));
+  }
+  const json ranking = rank_backends({{"cases", cases}});
+  ASSERT_EQ(ranking.size(), 2u);
+  ASSERT_EQ(ranking[0]["backend"], "simd");
+  EXPECT_NEAR(ranking[0]["methods"]["sphere"]["of_peak"].get<double>(), 0.4, 1e-12);  // sqrt(0.16)
+  EXPECT_FALSE(ranking[1]["methods"]["sphere"].contains("of_peak"));  // the scalar backend's
+}
+
 TEST(Gate, DeterministicFiguresAreHeldToTheirTolerance) {
   const json fingerprint = {{"cpu", {{"model", "test"}}}};
   json before = {
