@@ -935,9 +935,13 @@ int PacketLanes() {
 }
 
 // Lanes wait for a new pixel until this many eighths of them do: refilling costs a shading and a
-// camera ray for the whole packet, and waiting lanes idle. 2/8 measured best on the L-shape
-// (utilisation 0.95 against 0.87 at 4/8; 1/8 spends more on refills than it gains).
-constexpr size_t kRefillAt = 2;
+// camera ray for the whole packet, and waiting lanes idle. Measured on 8 lanes, 640x360, 2 cores,
+// one run (ms at 2/8 -> 4/8): the analytic method's short rays refill often and gain (cube
+// 24.9 -> 20.4, double pentagon 13.8 -> 11.4, L-shape 8.9 -> 8.4); so does sphere tracing in the
+// cube (228 -> 183: rays refilled together start together in the camera's room, and stay in
+// fewer rooms a packet), while on the L-shape and the torus it is level (86.7 -> 87.8, 52.1 ->
+// 52.1); 5/8 loses 18% on the L-shape's sphere tracing, 1/8 spends more on refills than it gains.
+constexpr size_t kRefillAt = 4;
 
 // Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
 // grid of tiles and writes them. The lanes of one packet take the chunk's pixels tile by tile,
