@@ -224,7 +224,7 @@ void add_report(CLI::App& app) {
       r.scaling.backends = r.matrix.backends;
       r.scaling.polygon_n.clear();
       for (int n = 2; n <= 32; ++n) r.scaling.polygon_n.push_back(n);
-      r.scaling.staircase_squares = {2, 4, 8, 16, 32, 64};
+      r.scaling.staircase_squares = {2, 4, 8, 16, 32, 64, 128};
       r.scaling.resolutions = {{80, 45}, {160, 90}, {320, 180}, {640, 360}, {1280, 720}};
       r.scaling.max_distances = {10, 20, 40, 80, 160, 320};
     } else {
