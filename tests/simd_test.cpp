@@ -164,24 +164,17 @@ TEST(Simd, LaneCountsAddUpToTheSteps) {
 TEST(Simd, RoomStepsStepEveryLaneOfTheCentralPacket) {
   const Scene& scene = test::gallery_scene("torus");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
-  simd::PacketJob job = simd::packet_job(tables);
-  job.basis = camera_basis<float>(float(scene.camera.yaw_deg), float(scene.camera.pitch_deg),
-                                  float(scene.camera.fov_deg), 64, 48);
-  job.polygon = scene.camera.polygon;
-  job.from = glm::vec3(scene.camera.position);
-  job.width = 64;
-  job.height = 48;
+  Frame none;
   const simd::PacketCode code = simd::packet_code(0);
-  EXPECT_EQ(code.room_steps(job, 5), 5 * code.lanes());
+  EXPECT_EQ(code.room_steps(simd::frame_job(tables, scene.camera, 64, 48, none), 5),
+            5 * code.lanes());
   EXPECT_GT(SimdBackend().peak_lane_steps(scene, scene.camera, 64, 48, {}, 0.01), 0.0);
 
   // Above the band, looking up: every ray misses as it starts.
   Camera up = scene.camera;
   up.position.z = 2.0 * tables.params.height + 1.0;
   up.pitch_deg = 80.0;
-  job.basis =
-      camera_basis<float>(float(up.yaw_deg), float(up.pitch_deg), float(up.fov_deg), 64, 48);
-  job.from = glm::vec3(up.position);
+  const simd::PacketJob job = simd::frame_job(tables, up, 64, 48, none);
   EXPECT_EQ(code.room_steps(job, 5), 0);
   EXPECT_EQ(SimdBackend().peak_lane_steps(scene, up, 64, 48, {}, 0.01), 0.0);
 }

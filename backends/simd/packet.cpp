@@ -934,13 +934,35 @@ int PacketLanes() {
   return static_cast<int>(hn::Lanes(D()));
 }
 
+// camera_ray for each lane's pixel (i, j): through the pixel's centre, normalised.
+HWY_INLINE void CameraRays(const PacketJob& job, const int32_t* i, const int32_t* j, V& dx, V& dy,
+                           V& dz) {
+  const DI di;
+  const CameraBasis<float>& c = job.basis;
+  const V px = hn::ConvertTo(D(), hn::LoadU(di, i)) + Splat(0.5f);
+  const V py = hn::ConvertTo(D(), hn::LoadU(di, j)) + Splat(0.5f);
+  const V u =
+      ((Splat(2.0f) * px / Splat(static_cast<float>(job.width)) - Splat(1.0f)) * Splat(c.aspect)) *
+      Splat(c.tan_half_fov);
+  const V v = (Splat(1.0f) - Splat(2.0f) * py / Splat(static_cast<float>(job.height))) *
+              Splat(c.tan_half_fov);
+  dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
+  dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
+  dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
+  const V inv = Splat(1.0f) / hn::Sqrt(dx * dx + dy * dy + dz * dz);
+  dx = dx * inv;
+  dy = dy * inv;
+  dz = dz * inv;
+}
+
 // Lanes wait for a new pixel until this many eighths of them do: refilling costs a shading and a
 // camera ray for the whole packet, and waiting lanes idle. Measured on 8 lanes, 640x360, 2 cores,
 // one run (ms at 2/8 -> 4/8): the analytic method's short rays refill often and gain (cube
 // 24.9 -> 20.4, double pentagon 13.8 -> 11.4, L-shape 8.9 -> 8.4); so does sphere tracing in the
 // cube (228 -> 183: rays refilled together start together in the camera's room, and stay in
 // fewer rooms a packet), while on the L-shape and the torus it is level (86.7 -> 87.8, 52.1 ->
-// 52.1); 5/8 loses 18% on the L-shape's sphere tracing, 1/8 spends more on refills than it gains.
+// 52.1; a recheck in three interleaved rounds: the L-shape up to 5% slower, within this machine's
+// noise); 5/8 loses 18% on the L-shape's sphere tracing, 1/8 spends more on refills than it gains.
 constexpr size_t kRefillAt = 4;
 
 // Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
@@ -950,7 +972,6 @@ constexpr size_t kRefillAt = 4;
 void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
   const TileShape tile = tile_shape(PacketLanes());
   const Marcher marcher(*job.tables, job.edge_extra, nullptr, 0);
-  const CameraBasis<float>& c = job.basis;
   const DI di;
   constexpr size_t kMax = hn::MaxLanes(DI());
   const size_t n = hn::Lanes(D());
@@ -958,8 +979,6 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   std::array<int32_t, kMax> steps{}, crossings{}, hit{}, fresh{};
   std::array<int32_t, kMax> pixel_i{}, pixel_j{};
   pixel_i.fill(-1);  // -1: the lane holds no pixel
-  const V width = Splat(static_cast<float>(job.width));
-  const V height = Splat(static_cast<float>(job.height));
   const V from_x = Splat(job.from.x), from_y = Splat(job.from.y), from_z = Splat(job.from.z);
 
   // The chunk's pixels in queue order: tile by tile, row-major; lane order within a tile.
@@ -1019,19 +1038,8 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
     }
     if (refill) {
       const M m = hn::RebindMask(D(), hn::MaskFromVec(hn::LoadU(di, fresh.data())));
-      // camera_ray: through the pixel's centre.
-      const V px = hn::ConvertTo(D(), hn::LoadU(di, pixel_i.data())) + Splat(0.5f);
-      const V py = hn::ConvertTo(D(), hn::LoadU(di, pixel_j.data())) + Splat(0.5f);
-      const V u =
-          ((Splat(2.0f) * px / width - Splat(1.0f)) * Splat(c.aspect)) * Splat(c.tan_half_fov);
-      const V v = (Splat(1.0f) - Splat(2.0f) * py / height) * Splat(c.tan_half_fov);
-      V dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
-      V dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
-      V dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
-      const V inv = Splat(1.0f) / hn::Sqrt(dx * dx + dy * dy + dz * dz);
-      dx = dx * inv;
-      dy = dy * inv;
-      dz = dz * inv;
+      V dx, dy, dz;
+      CameraRays(job, pixel_i.data(), pixel_j.data(), dx, dy, dz);
       marcher.start(r, x, seg, m, job.polygon, from_x, from_y, from_z, dx, dy, dz);
       continue;  // a ray may end as it starts (a miss): write it out before stepping
     }
@@ -1045,7 +1053,6 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
 void CentralPacket(const PacketJob& job, const Marcher& marcher, Packet& r, Relaxation& x,
                    Segment& seg) {
   const TileShape tile = tile_shape(PacketLanes());
-  const CameraBasis<float>& c = job.basis;
   constexpr size_t kMax = hn::MaxLanes(DI());
   std::array<int32_t, kMax> pixel_i{}, pixel_j{};
   for (size_t l = 0; l < hn::Lanes(D()); ++l) {
@@ -1054,17 +1061,8 @@ void CentralPacket(const PacketJob& job, const Marcher& marcher, Packet& r, Rela
     pixel_i[l] = std::clamp(i, 0, job.width - 1);
     pixel_j[l] = std::clamp(j, 0, job.height - 1);
   }
-  const DI di;
-  const V px = hn::ConvertTo(D(), hn::LoadU(di, pixel_i.data())) + Splat(0.5f);
-  const V py = hn::ConvertTo(D(), hn::LoadU(di, pixel_j.data())) + Splat(0.5f);
-  const V u =
-      ((Splat(2.0f) * px / Splat(static_cast<float>(job.width)) - Splat(1.0f)) * Splat(c.aspect)) *
-      Splat(c.tan_half_fov);
-  const V v = (Splat(1.0f) - Splat(2.0f) * py / Splat(static_cast<float>(job.height))) *
-              Splat(c.tan_half_fov);
-  const V dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
-  const V dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
-  const V dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
+  V dx, dy, dz;
+  CameraRays(job, pixel_i.data(), pixel_j.data(), dx, dy, dz);
   Marcher::clear(r, x, seg);
   marcher.start(r, x, seg, hn::Not(None()), job.polygon, Splat(job.from.x), Splat(job.from.y),
                 Splat(job.from.z), dx, dy, dz);

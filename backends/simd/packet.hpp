@@ -37,6 +37,11 @@ struct PacketJob {
 // A job on `tables` with its edge_extra filled in (no frame).
 PacketJob packet_job(const kernel::SceneTables<float>& tables);
 
+// The job of a frame of `tables` seen from `camera`, drawn into `frame`: packet_job, the
+// camera and the colour table (simd.cpp).
+PacketJob frame_job(const kernel::SceneTables<float>& tables, const Camera& camera, int width,
+                    int height, Frame& frame);
+
 // The tile of pixels one packet covers, for a vector of `lanes` lanes: as square as it can be.
 struct TileShape {
   int width = 1, height = 1;

@@ -32,6 +32,23 @@ constexpr int kTransmittanceTable = 4096;
 
 }  // namespace
 
+PacketJob frame_job(const kernel::SceneTables<float>& tables, const Camera& camera, int width,
+                    int height, Frame& frame) {
+  PacketJob job = packet_job(tables);
+  // As the kernel's shade computes it, in f32.
+  const int size = std::min(tables.params.max_steps, kTransmittanceTable) + 1;
+  const float clear = 1.0f - tables.params.wall_tint;
+  for (int c = 0; c < size; ++c) job.transmittance.push_back(glm::pow(clear, float(c)));
+  job.basis = camera_basis<float>(float(camera.yaw_deg), float(camera.pitch_deg),
+                                  float(camera.fov_deg), width, height);
+  job.polygon = camera.polygon;
+  job.from = glm::vec3(camera.position);
+  job.width = width;
+  job.height = height;
+  job.frame = &frame;
+  return job;
+}
+
 std::vector<std::string> isa_names(bool supported_only) {
   std::vector<std::string> names;
   const int64_t here = supported_only ? hwy::SupportedTargets() : ~int64_t{0};
@@ -101,24 +118,6 @@ void check_precision(const MarchParams& params) {
         "the simd backend marches in f32 only (the scalar backend runs f64)");
 }
 
-// The job of a frame: the compiled scene, the camera and the colour table.
-simd::PacketJob frame_job(const kernel::SceneTables<float>& tables, const Camera& camera, int width,
-                          int height, Frame& frame) {
-  simd::PacketJob job = simd::packet_job(tables);
-  // As the kernel's shade computes it, in f32.
-  const int size = std::min(tables.params.max_steps, simd::kTransmittanceTable) + 1;
-  const float clear = 1.0f - tables.params.wall_tint;
-  for (int c = 0; c < size; ++c) job.transmittance.push_back(glm::pow(clear, float(c)));
-  job.basis = camera_basis<float>(float(camera.yaw_deg), float(camera.pitch_deg),
-                                  float(camera.fov_deg), width, height);
-  job.polygon = camera.polygon;
-  job.from = glm::vec3(camera.position);
-  job.width = width;
-  job.height = height;
-  job.frame = &frame;
-  return job;
-}
-
 }  // namespace
 
 Frame SimdBackend::render(const Scene& scene, const Camera& camera, int width, int height,
@@ -134,7 +133,7 @@ Frame SimdBackend::render_counted(const Scene& scene, const Camera& camera, int 
   const simd::PacketCode packets = code();
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   Frame frame(width, height);
-  const simd::PacketJob job = frame_job(tables, camera, width, height, frame);
+  const simd::PacketJob job = simd::frame_job(tables, camera, width, height, frame);
   const simd::TileShape tile = simd::tile_shape(packets.lanes());
   const int rows = (height + tile.height - 1) / tile.height;
   const int cols = (width + tile.width - 1) / tile.width;
@@ -176,7 +175,7 @@ double SimdBackend::peak_lane_steps(const Scene& scene, const Camera& camera, in
   const simd::PacketCode packets = code();
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   Frame none;  // nothing is drawn
-  const simd::PacketJob job = frame_job(tables, camera, width, height, none);
+  const simd::PacketJob job = simd::frame_job(tables, camera, width, height, none);
   const int threads = options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
   // One thread a core, each stepping its own packet for `seconds`: what the cores make at once.
   std::vector<double> rates(static_cast<size_t>(threads), 0.0);
