@@ -1,0 +1,181 @@
+// The SIMD backend's vocabulary, per instruction set: the vector types (one lane per ray), the
+// few helpers the packet code reads as words (Splat, Select, Any), the march state of a packet
+// (march.glsl's Ray and the methods' state, one lane per ray), the rooms of a pass, and the
+// numbers of an edge the packet code reads.
+
+// The marcher's functions are inlined into one loop, but under the sanitizers GCC then takes
+// over ten minutes on that one function: there it decides what to inline.
+#ifndef FLATMARCH_PACKET_INLINE
+#ifdef FLATMARCH_SANITIZE_BUILD
+#define FLATMARCH_PACKET_INLINE inline
+#else
+#define FLATMARCH_PACKET_INLINE HWY_INLINE
+#endif
+#endif
+
+// Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
+// re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
+#if defined(FLATMARCH_BACKENDS_SIMD_LANES_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef FLATMARCH_BACKENDS_SIMD_LANES_INL_H_
+#undef FLATMARCH_BACKENDS_SIMD_LANES_INL_H_
+#else
+#define FLATMARCH_BACKENDS_SIMD_LANES_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include <array>
+
+#include "backends/simd/packet.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace flatmarch::simd {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using kernel::ivec4;
+using D = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<D>;
+using V = hn::Vec<D>;
+using VI = hn::Vec<DI>;
+using M = hn::Mask<D>;
+using EdgeRecord = kernel::Tables<float>::EdgeRecord;
+using ObjectRecord = kernel::Tables<float>::ObjectRecord;
+using KernelParams = kernel::Tables<float>::KernelParams;
+
+HWY_INLINE V Splat(float x) {
+  return hn::Set(D(), x);
+}
+HWY_INLINE VI SplatI(int x) {
+  return hn::Set(DI(), x);
+}
+HWY_INLINE M None() {
+  return hn::FirstN(D(), 0);
+}
+HWY_INLINE M Equal(VI a, int b) {
+  return hn::RebindMask(D(), a == SplatI(b));
+}
+HWY_INLINE M AtLeastZero(VI a) {
+  return hn::RebindMask(D(), a > SplatI(-1));
+}
+// m ? a : b, lane by lane.
+HWY_INLINE V Select(M m, V a, V b) {
+  return hn::IfThenElse(m, a, b);
+}
+HWY_INLINE VI Select(M m, VI a, VI b) {
+  return hn::IfThenElse(hn::RebindMask(DI(), m), a, b);
+}
+HWY_INLINE M Select(M m, M a, M b) {
+  return hn::Or(hn::And(m, a), hn::AndNot(m, b));
+}
+HWY_INLINE bool Any(M m) {
+  return !hn::AllFalse(D(), m);
+}
+// (x, y, z) scaled to length 1, as GLSL's normalize (one division, three products).
+HWY_INLINE void Normalize(V& x, V& y, V& z) {
+  const V inv = Splat(1.0f) / hn::Sqrt(x * x + y * y + z * z);
+  x = x * inv;
+  y = y * inv;
+  z = z * inv;
+}
+
+// What a packet of rays is doing (march.glsl's Ray, one lane per ray).
+struct Packet {
+  VI polygon;
+  V ox, oy, oz;  // point, in the coordinates of `polygon`
+  V dx, dy, dz;  // unit direction
+  V t;
+  VI steps, crossings, hit;
+  M done;
+  V nx, ny, nz;  // normal of the solid hit
+  V sr, sg, sb;  // colour of the solid hit
+};
+
+// The rays of `m` go on from (px, py) (their height unchanged) along (hx, hy, hz): where a
+// crossing or a bounce leaves them.
+HWY_INLINE void MoveTo(Packet& r, M m, V px, V py, V hx, V hy, V hz) {
+  r.ox = Select(m, px, r.ox);
+  r.oy = Select(m, py, r.oy);
+  r.dx = Select(m, hx, r.dx);
+  r.dy = Select(m, hy, r.dy);
+  r.dz = Select(m, hz, r.dz);
+}
+
+struct WallDistance {
+  V d;
+  VI edge;
+  V second;
+};
+
+struct Exit {
+  V s;
+  VI edge;
+  M corner;
+};
+
+struct SolidDistance {
+  V d;
+  VI object;
+};
+
+struct Relaxation {
+  V omega, last_radius, last_step;
+};
+
+struct Segment {
+  M known;
+  Exit exit;
+  V solids;
+};
+
+// The rooms of one pass: the polygons its rays are in (at most kRoomsPerPass) and the lanes in
+// each. A table read gives every lane its own room's record: in one room a broadcast, in several
+// a lookup of each lane's edge in vectors holding the scene's edges (Walls::lookup_; scenes
+// whose edges do not fit in a vector take one room a pass). Coherent rays are mostly in one room;
+// rays split between a few (the double pentagon's two, at every crossing) still take one pass a
+// step, not one per room.
+constexpr int kRoomsPerPass = 4;
+struct Rooms {
+  int count = 0;
+  int most_edges = 0;
+  std::array<int, kRoomsPerPass> polygon{};
+  std::array<M, kRoomsPerPass> lanes;  // the lanes in each
+  M all;                               // the lanes of the pass
+  VI first_edge, edge_count;           // of each lane's room, when there are several
+};
+
+// The numbers of an edge the packet code reads, by name.
+enum Field { kAx, kAy, kAbx, kAby, kAyAby, kNx, kNy, kNa, kInvLength2, kTolerance, kFields };
+inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra) {
+  switch (f) {
+    case kAx:
+      return e.segment.x;
+    case kAy:
+      return e.segment.y;
+    case kAbx:
+      return extra.x;
+    case kAby:
+      return extra.y;
+    case kAyAby:
+      return extra.w;
+    case kNx:
+      return e.line.x;
+    case kNy:
+      return e.line.y;
+    case kNa:
+      return e.line.z;
+    case kInvLength2:
+      return e.line.w;
+    case kTolerance:
+      return extra.z;
+    case kFields:
+      break;
+  }
+  return 0.0f;
+}
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace flatmarch::simd
+HWY_AFTER_NAMESPACE();
+#endif  // FLATMARCH_BACKENDS_SIMD_LANES_INL_H_

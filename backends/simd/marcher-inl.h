@@ -1,0 +1,439 @@
+// The kernel of kernels/march.glsl run on packets of rays with Google Highway: one ray per lane,
+// a packet covering a small tile of pixels (packet.hpp's tile_shape), its march state in vectors.
+// The functions mirror march.glsl's one for one, with the same names, operations and order of
+// floating-point operations (and no fused multiply-add: this file is compiled with
+// -ffp-contract=off), so that a lane takes exactly the steps the scalar backend takes.
+//
+// What differs is control flow. Where the kernel branches, a packet computes under masks and
+// blends. The tables are read per room, not per lane: a step runs in passes over a few rooms
+// among the packet's unfinished rays, and a table read is one record per room, broadcast and
+// blended (a coherent tile's rays are mostly in one room, so this is usually one broadcast; no
+// gathers). A lane whose ray has ended is masked off until it takes the next pixel; the share
+// of lanes doing work in a pass is the lane utilisation the benchmark reports.
+//
+// Included by packet.cpp once per instruction set.
+
+// Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
+// re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
+#if defined(FLATMARCH_BACKENDS_SIMD_MARCHER_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef FLATMARCH_BACKENDS_SIMD_MARCHER_INL_H_
+#undef FLATMARCH_BACKENDS_SIMD_MARCHER_INL_H_
+#else
+#define FLATMARCH_BACKENDS_SIMD_MARCHER_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+#include "backends/simd/lanes-inl.h"
+#include "backends/simd/solids-inl.h"
+#include "backends/simd/walls-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace flatmarch::simd {
+namespace HWY_NAMESPACE {
+
+class Marcher {
+ public:
+  Marcher(const kernel::SceneTables<float>& tables, const std::vector<glm::vec4>& edge_extra,
+          std::vector<kernel::KernelEvent>* events, int max_events)
+      : walls_(tables, edge_extra),
+        solids_(tables),
+        polygons_(tables.polygons.data()),
+        edges_(tables.edges.data()),
+        objects_(tables.objects.data()),
+        params_(tables.params),
+        features_(tables.features),
+        events_(events),
+        max_events_(max_events) {}
+
+  // A packet with no rays: every lane done.
+  static void clear(Packet& r, Relaxation& x, Segment& seg) {
+    r.polygon = r.steps = r.crossings = r.hit = SplatI(0);
+    r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = r.t = Splat(0.0f);
+    r.nx = r.ny = r.nz = r.sr = r.sg = r.sb = Splat(0.0f);
+    r.done = hn::Not(None());
+    x.omega = x.last_radius = x.last_step = Splat(0.0f);
+    seg.known = seg.exit.corner = None();
+    seg.exit.s = seg.solids = Splat(0.0f);
+    seg.exit.edge = SplatI(-1);
+  }
+
+  // The start of march.glsl's march(): the lanes of `m` begin a ray from (fx, fy, fz) in
+  // `polygon` along (dx, dy, dz). The other lanes are left as they are.
+  FLATMARCH_PACKET_INLINE void start(Packet& r, Relaxation& x, Segment& seg, M m, int polygon, V fx,
+                                     V fy, V fz, V dx, V dy, V dz) const {
+    r.polygon = Select(m, SplatI(polygon), r.polygon);
+    Normalize(dx, dy, dz);
+    MoveTo(r, m, fx, fy, dx, dy, dz);
+    r.oz = Select(m, fz, r.oz);
+    r.t = hn::IfThenZeroElse(m, r.t);
+    r.steps = Select(m, SplatI(0), r.steps);
+    r.crossings = Select(m, SplatI(0), r.crossings);
+    r.hit = Select(m, SplatI(kHitMaxSteps), r.hit);
+    r.done = hn::AndNot(m, r.done);
+    // The normal and surface colour are left: only a ray that hits a solid reads them, and the
+    // hit sets them.
+    if (has(kFeaturePeriod)) {
+      const V top = Splat(params_.top);
+      r.oz = Select(m, r.oz - top * hn::Floor(r.oz / top), r.oz);  // mod
+    } else {
+      const M below = hn::Lt(r.oz, Splat(0.0f)), above = hn::Gt(r.oz, Splat(params_.height));
+      enter_band(r, hn::And(m, hn::Or(below, above)));
+    }
+    relax(x, m);
+    seg.known = hn::AndNot(m, seg.known);
+    seg.exit.s = Select(m, Splat(kFar), seg.exit.s);
+    seg.exit.edge = Select(m, SplatI(-1), seg.exit.edge);
+    seg.exit.corner = hn::AndNot(m, seg.exit.corner);
+    seg.solids = Select(m, Splat(kFar), seg.solids);
+  }
+
+  // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
+  // of the rays that have taken max_steps. A step runs in passes of up to kRoomsPerPass rooms
+  // (usually one pass); the rays a pass moves to another room are already out of `pending`.
+  FLATMARCH_PACKET_INLINE void step(Packet& r, Relaxation& x, Segment& seg,
+                                    LaneCounts& lanes) const {
+    const M active = hn::Not(r.done);
+    r.steps = Select(active, r.steps + SplatI(1), r.steps);
+    std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
+    hn::StoreU(r.polygon, DI(), lane_rooms.data());
+    M pending = active;
+    while (Any(pending)) {
+      Rooms rooms;
+      M pass = None();
+      rooms.first_edge = rooms.edge_count = SplatI(0);
+      const int most_rooms = walls_.merge() ? kRoomsPerPass : 1;
+      for (M left = pending; Any(left) && rooms.count < most_rooms; ++rooms.count) {
+        const int polygon = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
+        const M in = hn::And(left, Equal(r.polygon, polygon));
+        const ivec4 poly = polygons_[polygon];
+        rooms.polygon[static_cast<size_t>(rooms.count)] = polygon;
+        rooms.lanes[static_cast<size_t>(rooms.count)] = in;
+        rooms.most_edges = std::max(rooms.most_edges, poly.y);
+        rooms.first_edge = Select(in, SplatI(poly.x), rooms.first_edge);
+        rooms.edge_count = Select(in, SplatI(poly.y), rooms.edge_count);
+        pass = hn::Or(pass, in);
+        left = hn::AndNot(in, left);
+      }
+      rooms.all = pass;
+      lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
+      lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
+      const bool analytic = params_.method == kMethodAnalytic;
+      if (rooms.count == 1 && analytic)
+        analytic_step<true>(r, seg, pass, rooms);
+      else if (rooms.count == 1)
+        sphere_step<true>(r, x, pass, rooms);
+      else if (analytic)
+        analytic_step<false>(r, seg, pass, rooms);
+      else
+        sphere_step<false>(r, x, pass, rooms);
+      pending = hn::AndNot(pass, pending);
+    }
+    const M out = hn::AndNot(r.done, hn::RebindMask(D(), r.steps == SplatI(params_.max_steps)));
+    finish(r, out, SplatI(kHitMaxSteps), kEventMaxSteps, SplatI(-1), Splat(0.0f));
+  }
+
+ private:
+  bool has(uint feature) const { return (features_ & feature) != 0u; }
+
+  // Records an event of lane 0 (the one a trace follows) when it is in `m`.
+  FLATMARCH_PACKET_INLINE void record(M m, int kind, VI polygon, VI edge, int to_polygon,
+                                      int to_edge, VI hit, const Packet& r) const {
+    if (!events_ || static_cast<int>(events_->size()) >= max_events_ ||
+        hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1))))
+      return;
+    const int h = hn::GetLane(hit);
+    events_->push_back({kind, hn::GetLane(polygon), hn::GetLane(edge), to_polygon, to_edge,
+                        h >= 0 ? h : -1, static_cast<double>(hn::GetLane(r.t)),
+                        glm::dvec3(hn::GetLane(r.ox), hn::GetLane(r.oy), hn::GetLane(r.oz))});
+  }
+
+  static FLATMARCH_PACKET_INLINE void advance(Packet& r, M m, V s) {
+    r.ox = Select(m, r.ox + s * r.dx, r.ox);
+    r.oy = Select(m, r.oy + s * r.dy, r.oy);
+    r.oz = Select(m, r.oz + s * r.dz, r.oz);
+    r.t = Select(m, r.t + s, r.t);
+  }
+
+  // Ends the rays of `m` `s` further on.
+  FLATMARCH_PACKET_INLINE void finish(Packet& r, M m, VI hit, int event, VI edge, V s) const {
+    if (!Any(m)) return;
+    advance(r, m, s);
+    r.hit = Select(m, hit, r.hit);
+    r.done = hn::Or(r.done, m);
+    record(m, event, r.polygon, edge, -1, -1, hit, r);
+  }
+
+  // The rays of `m` at their edge `edge` (of their room) go through it or are reflected, and are
+  // placed `push` inside the edge they are then behind. One broadcast record per edge.
+  FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, VI edge, V push) const {
+    if (walls_.merge() && !has(kFeatureMirrors)) {
+      if (events_ && !hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1)))) {
+        const ivec4 link = edges_[polygons_[hn::GetLane(r.polygon)].x + hn::GetLane(edge)].link;
+        record(m, kEventGluing, r.polygon, edge, link.y, link.z, SplatI(-1), r);
+      }
+      walls_.cross_glued(r, m, edge, push);
+      return;
+    }
+    std::array<int32_t, hn::MaxLanes(DI())> lane_edges{}, lane_rooms{};
+    hn::StoreU(edge, DI(), lane_edges.data());
+    hn::StoreU(r.polygon, DI(), lane_rooms.data());
+    // One round per edge the rays cross (usually one or two), not per edge of their rooms.
+    for (M left = m; Any(left);) {
+      const size_t first = static_cast<size_t>(hn::FindFirstTrue(D(), left));
+      const int k = lane_edges[first], polygon = lane_rooms[first];
+      const M mk = hn::And(left, hn::And(Equal(edge, k), Equal(r.polygon, polygon)));
+      left = hn::AndNot(mk, left);
+      const EdgeRecord& e = edges_[polygons_[polygon].x + k];
+      V px = r.ox, py = r.oy;
+      V hx = r.dx, hy = r.dy, hz = r.dz;
+      if (has(kFeatureMirrors) && e.link.x == kEdgeMirror) {
+        record(mk, kEventMirror, r.polygon, SplatI(k), -1, -1, SplatI(-1), r);
+        const V nx = Splat(e.line.x), ny = Splat(e.line.y);
+        Walls::place(px, py, e.line, push);
+        const V twice = Splat(2.0f) * (hx * nx + hy * ny);
+        hx = hx - twice * nx;
+        hy = hy - twice * ny;
+      } else {
+        const ivec4 link = e.link;
+        record(mk, kEventGluing, r.polygon, SplatI(k), link.y, link.z, SplatI(-1), r);
+        const glm::vec4 a = e.map_linear;
+        if (a == glm::vec4(1.0f, 0.0f, 0.0f, 1.0f)) {  // a translation: what the map gives
+          px = r.ox + Splat(e.map_shift.x);
+          py = r.oy + Splat(e.map_shift.y);
+        } else {
+          const V mx = Splat(a.x), my = Splat(a.y), mz = Splat(a.z), mw = Splat(a.w);
+          px = (mx * r.ox + mz * r.oy) + Splat(e.map_shift.x);
+          py = (my * r.ox + mw * r.oy) + Splat(e.map_shift.y);
+          hx = mx * r.dx + mz * r.dy;
+          hy = my * r.dx + mw * r.dy;
+        }
+        Walls::place(px, py, edges_[polygons_[link.y].x + link.z].line, push);
+        if (has(kFeatureScaled)) {  // normalize
+          Normalize(hx, hy, hz);
+        }
+        r.polygon = Select(mk, SplatI(link.y), r.polygon);
+      }
+      MoveTo(r, mk, px, py, hx, hy, hz);
+    }
+    r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
+  }
+
+  // The rays of `m` reach the top or bottom of the band, `s` further on.
+  FLATMARCH_PACKET_INLINE void leave_band(Packet& r, M m, V s) const {
+    if (has(kFeaturePeriod)) {
+      advance(r, m, s);
+      r.oz = Select(m, Select(r.dz > Splat(0.0f), Splat(0.0f), Splat(params_.top)), r.oz);
+    } else if (has(kFeatureFloor)) {
+      const M down = hn::And(m, r.dz < Splat(0.0f));
+      finish(r, down, SplatI(kHitFloor), kEventFloor, SplatI(-1), s);
+      r.nz = Select(down, Splat(1.0f), r.nz);
+      finish(r, hn::AndNot(down, m), SplatI(kHitEscape), kEventEscape, SplatI(-1), s);
+    } else {
+      finish(r, m, SplatI(kHitEscape), kEventEscape, SplatI(-1), s);
+    }
+  }
+
+  // The rays of `m` hit their `object` (an index in the object table) where they are.
+  FLATMARCH_PACKET_INLINE void hit_solid(Packet& r, M m, VI object) const {
+    std::array<int32_t, hn::MaxLanes(DI())> lane_objects{};
+    hn::StoreU(object, DI(), lane_objects.data());
+    for (M left = m; Any(left);) {
+      const int k = lane_objects[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
+      const M mk = hn::And(left, Equal(object, k));
+      left = hn::AndNot(mk, left);
+      V nx, ny, nz;
+      solids_.solid_normal(k, r.ox, r.oy, r.oz, nx, ny, nz);
+      r.nx = Select(mk, nx, r.nx);
+      r.ny = Select(mk, ny, r.ny);
+      r.nz = Select(mk, nz, r.nz);
+      const glm::vec4 c = objects_[k].color;
+      const V half = Splat(0.5f);
+      r.sr = Select(mk, c.w > 0.0f ? Splat(c.x) : half + half * nx, r.sr);
+      r.sg = Select(mk, c.w > 0.0f ? Splat(c.y) : half + half * ny, r.sg);
+      r.sb = Select(mk, c.w > 0.0f ? Splat(c.z) : half + half * nz, r.sb);
+      finish(r, mk, SplatI(objects_[k].info.y), kEventObject, SplatI(-1), Splat(0.0f));
+    }
+  }
+
+  // ---- Methods -------------------------------------------------------------------------------
+
+  FLATMARCH_PACKET_INLINE void relax(Relaxation& x, M m) const {
+    const V omega = Splat(params_.method == kMethodRelaxed ? params_.omega : 1.0f);
+    x.omega = Select(m, omega, x.omega);
+    x.last_radius = hn::IfThenZeroElse(m, x.last_radius);
+    x.last_step = hn::IfThenZeroElse(m, x.last_step);
+  }
+
+  // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `rooms`.
+  template <bool kOneRoom>
+  FLATMARCH_PACKET_INLINE void sphere_step(Packet& r, Relaxation& x, M m,
+                                           const Rooms& rooms) const {
+    const WallDistance wall = walls_.wall_distance<kOneRoom>(rooms, r.ox, r.oy);
+    const SolidDistance solid = solids_.nearest_solid(rooms, r.ox, r.oy, r.oz);
+    const V radius = hn::Min(wall.d, solid.d);
+    // Over-relaxed steps whose unbounding spheres do not overlap are taken back.
+    const M back = hn::And(hn::And(m, x.omega > Splat(1.0f)), radius + x.last_radius < x.last_step);
+    M rest = hn::AndNot(back, m);
+    if (Any(back)) {
+      advance(r, back, x.last_radius - x.last_step);
+      x.last_step = Select(back, x.last_radius, x.last_step);
+      x.omega = Select(back, Splat(1.0f), x.omega);
+    }
+    const V wall_d = hn::Abs(wall.d);
+    const V eps = Splat(params_.eps);
+    const M hit = hn::And(rest, hn::And(solid.d < eps, solid.d <= wall_d));
+    if (Any(hit)) {
+      hit_solid(r, hit, solid.object);
+      rest = hn::AndNot(hit, rest);
+    }
+    const M near = hn::And(rest, wall_d < eps);
+    if (Any(near)) {
+      const M corner = hn::And(near, wall.second < eps);
+      finish(r, corner, SplatI(kHitVertex), kEventVertex, SplatI(-1), Splat(0.0f));
+      const M walls = hn::AndNot(corner, hn::And(near, walls_.is_wall(rooms, wall.edge)));
+      finish(r, walls, SplatI(kHitWall), kEventWall, wall.edge, Splat(0.0f));
+      const M cross = hn::AndNot(hn::Or(corner, walls), near);
+      if (Any(cross)) {
+        cross_edge(r, cross, wall.edge, Splat(params_.offset));
+        relax(x, cross);
+      }
+      rest = hn::AndNot(near, rest);
+    }
+    const V safe = hn::Abs(radius);
+    const V band = walls_.band_exit(r.oz, r.dz);
+    const V remaining = Splat(params_.max_distance) - r.t;
+    const M far = hn::And(rest, remaining <= hn::Min(safe, band));
+    finish(r, far, SplatI(kHitMaxDistance), kEventMaxDistance, SplatI(-1), remaining);
+    rest = hn::AndNot(far, rest);
+    const M leave = hn::And(rest, band <= safe);
+    if (Any(leave)) {
+      leave_band(r, leave, band);
+      relax(x, leave);
+      rest = hn::AndNot(leave, rest);
+    }
+    x.last_radius = Select(rest, safe, x.last_radius);
+    x.last_step = Select(rest, hn::Min(x.omega * safe, hn::Min(band, remaining)), x.last_step);
+    advance(r, rest, x.last_step);
+  }
+
+  static FLATMARCH_PACKET_INLINE void move_in_segment(Packet& r, Segment& seg, M m, V s) {
+    advance(r, m, s);
+    seg.exit.s = Select(m, seg.exit.s - s, seg.exit.s);
+    seg.solids = Select(m, hn::Max(seg.solids - s, Splat(0.0f)), seg.solids);
+  }
+
+  // One iteration of the analytic method for the rays of `m`, in `rooms`.
+  template <bool kOneRoom>
+  FLATMARCH_PACKET_INLINE void analytic_step(Packet& r, Segment& seg, M m,
+                                             const Rooms& rooms) const {
+    const M unknown = hn::AndNot(seg.known, m);
+    if (Any(unknown)) {
+      const Exit x = walls_.exit_edge<kOneRoom>(unknown, rooms, r.ox, r.oy, r.dx, r.dy);
+      seg.exit.s = Select(unknown, x.s, seg.exit.s);
+      seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
+      seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
+      if (has(kFeatureObjects))
+        seg.solids = Select(unknown, solids_.solid_entry(rooms, r), seg.solids);
+      else
+        seg.solids = Select(unknown, Splat(kFar), seg.solids);
+      seg.known = hn::Or(seg.known, unknown);
+    }
+    const V max_distance = Splat(params_.max_distance);
+    V remaining = max_distance - r.t;
+    V band = walls_.band_exit(r.oz, r.dz);  // recomputed below for the rays that move
+    M rest = m;
+    if (has(kFeatureObjects)) {
+      const M solids = hn::And(m, seg.solids < hn::Min(hn::Min(seg.exit.s, band), remaining));
+      if (Any(solids)) {
+        move_in_segment(r, seg, solids, seg.solids);
+        band = Select(solids, walls_.band_exit(r.oz, r.dz), band);
+        const SolidDistance solid = solids_.nearest_solid(rooms, r.ox, r.oy, r.oz);
+        const M hit = hn::And(solids, solid.d < Splat(params_.eps));
+        hit_solid(r, hit, solid.object);
+        const M on = hn::AndNot(hit, solids);
+        remaining = Select(on, max_distance - r.t, remaining);
+        const M step = hn::And(on, solid.d < hn::Min(hn::Min(seg.exit.s, band), remaining));
+        move_in_segment(r, seg, step, solid.d);
+        rest = hn::AndNot(hn::Or(hit, step), rest);
+      }
+    }
+    const M far = hn::And(rest, remaining < hn::Min(seg.exit.s, band));
+    finish(r, far, SplatI(kHitMaxDistance), kEventMaxDistance, SplatI(-1), remaining);
+    rest = hn::AndNot(far, rest);
+    const M leave = hn::And(rest, band <= seg.exit.s);
+    if (Any(leave)) {
+      leave_band(r, leave, band);
+      seg.known = hn::AndNot(leave, seg.known);
+      rest = hn::AndNot(leave, rest);
+    }
+    const M no_edge = hn::RebindMask(D(), seg.exit.edge < SplatI(0));
+    const M vertex = hn::And(rest, hn::Or(no_edge, seg.exit.corner));
+    finish(r, vertex, SplatI(kHitVertex), kEventVertex, SplatI(-1),
+           hn::IfThenZeroElse(no_edge, seg.exit.s));
+    rest = hn::AndNot(vertex, rest);
+    const M wall = hn::And(rest, walls_.is_wall(rooms, seg.exit.edge));
+    finish(r, wall, SplatI(kHitWall), kEventWall, seg.exit.edge, seg.exit.s);
+    rest = hn::AndNot(wall, rest);
+    if (Any(rest)) {
+      advance(r, rest, seg.exit.s);
+      cross_edge(r, rest, seg.exit.edge, Splat(0.0f));
+      seg.known = hn::AndNot(rest, seg.known);
+    }
+  }
+
+  // ---- A whole ray ---------------------------------------------------------------------------
+
+  // The rays of `m`, outside the band, enter the first polygon whose footprint they cross.
+  FLATMARCH_PACKET_INLINE void enter_band(Packet& r, M m) const {
+    if (!Any(m)) return;
+    const V height = Splat(params_.height), max_distance = Splat(params_.max_distance);
+    const M above = r.oz > height;
+    const M toward = Select(above, r.dz<Splat(0.0f), r.dz> Splat(0.0f));
+    V s = Select(toward, (hn::IfThenElseZero(above, height) - r.oz) / r.dz, max_distance);
+    s = Select(s > max_distance, max_distance, s);
+    const V qx = r.ox + s * r.dx, qy = r.oy + s * r.dy;
+    M open = hn::And(m, s < max_distance);
+    for (int k = 0; k < params_.polygon_count && Any(open); ++k) {
+      const M in = hn::And(open, walls_.inside_polygon(k, qx, qy));
+      if (!Any(in)) continue;
+      r.polygon = Select(in, SplatI(k), r.polygon);
+      M enter = in;
+      if (has(kFeatureFloor)) {  // the underside of the floor
+        const M under = hn::AndNot(above, in);
+        finish(r, under, SplatI(kHitFloor), kEventFloor, SplatI(-1), s);
+        r.nz = Select(under, Splat(-1.0f), r.nz);
+        enter = hn::AndNot(under, in);
+      }
+      advance(r, enter, s);
+      record(enter, kEventEnter, SplatI(k), SplatI(-1), -1, -1, SplatI(-1), r);
+      open = hn::AndNot(in, open);
+      m = hn::AndNot(in, m);
+    }
+    if (!Any(m)) return;
+    advance(r, m, s);
+    r.hit = Select(m, SplatI(kHitMiss), r.hit);
+    r.done = hn::Or(r.done, m);
+    record(m, kEventMiss, SplatI(-1), SplatI(-1), -1, -1, SplatI(-1), r);
+  }
+
+  Walls walls_;
+  Solids solids_;
+  const ivec4* polygons_;
+  const EdgeRecord* edges_;
+  const ObjectRecord* objects_;
+  KernelParams params_;
+  uint features_;
+  std::vector<kernel::KernelEvent>* events_;
+  int max_events_;
+};
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace flatmarch::simd
+HWY_AFTER_NAMESPACE();
+#endif  // FLATMARCH_BACKENDS_SIMD_MARCHER_INL_H_

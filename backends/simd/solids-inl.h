@@ -1,0 +1,118 @@
+// The solids of a pass's rooms for packets of rays (march.glsl's "Solids"): their distances,
+// where rays reach their bounding spheres, and their normals. One broadcast record per solid.
+
+// Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
+// re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
+#if defined(FLATMARCH_BACKENDS_SIMD_SOLIDS_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef FLATMARCH_BACKENDS_SIMD_SOLIDS_INL_H_
+#undef FLATMARCH_BACKENDS_SIMD_SOLIDS_INL_H_
+#else
+#define FLATMARCH_BACKENDS_SIMD_SOLIDS_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include "backends/simd/lanes-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace flatmarch::simd {
+namespace HWY_NAMESPACE {
+
+class Solids {
+ public:
+  explicit Solids(const kernel::SceneTables<float>& tables)
+      : polygons_(tables.polygons.data()),
+        objects_(tables.objects.data()),
+        params_(tables.params),
+        features_(tables.features) {}
+
+  FLATMARCH_PACKET_INLINE V solid_distance(int k, V px, V py, V pz) const {
+    const ObjectRecord& o = objects_[k];
+    const V qx = px - Splat(o.center.x), qy = py - Splat(o.center.y);
+    const V qz = pz - Splat(o.center.z);
+    const int solid = o.info.x;
+    if (solid == kSolidSphere) return hn::Sqrt(qx * qx + qy * qy + qz * qz) - Splat(o.shape.x);
+    const V zero = Splat(0.0f);
+    if (solid == kSolidCylinder) {
+      const V wx = hn::Sqrt(qx * qx + qy * qy) - Splat(o.shape.x);
+      const V wy = hn::Abs(qz) - Splat(o.shape.y);
+      const V mx = hn::Max(wx, zero), my = hn::Max(wy, zero);
+      return hn::Min(hn::Max(wx, wy), zero) + hn::Sqrt(mx * mx + my * my);
+    }
+    const V wx = hn::Abs(qx) - Splat(o.shape.x), wy = hn::Abs(qy) - Splat(o.shape.y);
+    const V wz = hn::Abs(qz) - Splat(o.shape.z);
+    const V mx = hn::Max(wx, zero), my = hn::Max(wy, zero), mz = hn::Max(wz, zero);
+    const V box =
+        hn::Sqrt(mx * mx + my * my + mz * mz) + hn::Min(hn::Max(wx, hn::Max(wy, wz)), zero);
+    if (solid == kSolidBox) return box;
+    return hn::Max(box, Splat(o.shape.w) - hn::Sqrt(qx * qx + qy * qy + qz * qz));
+  }
+
+  FLATMARCH_PACKET_INLINE SolidDistance nearest_solid(const Rooms& rooms, V px, V py, V pz) const {
+    SolidDistance best;
+    best.d = Splat(kFar);
+    best.object = SplatI(-1);
+    if (!has(kFeatureObjects)) return best;
+    for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
+      const ivec4 poly = polygons_[rooms.polygon[i]];
+      for (int k = poly.z; k < poly.z + poly.w; ++k) {
+        const V dk = solid_distance(k, px, py, pz);
+        const M nearer = hn::And(rooms.lanes[i], dk < best.d);
+        best.d = Select(nearer, dk, best.d);
+        best.object = Select(nearer, SplatI(k), best.object);
+      }
+    }
+    return best;
+  }
+
+  // Where a ray first comes within eps of a solid's bounding sphere in its room, or kFar.
+  FLATMARCH_PACKET_INLINE V solid_entry(const Rooms& rooms, const Packet& r) const {
+    V first = Splat(kFar);
+    M inside = None();
+    for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
+      const ivec4 poly = polygons_[rooms.polygon[i]];
+      for (int k = poly.z; k < poly.z + poly.w; ++k) {
+        const glm::vec4 c = objects_[k].center;
+        const V ocx = r.ox - Splat(c.x), ocy = r.oy - Splat(c.y), ocz = r.oz - Splat(c.z);
+        const float radius = c.w + params_.eps;
+        const V b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
+        const V cc = (ocx * ocx + ocy * ocy + ocz * ocz) - Splat(radius * radius);
+        inside = hn::Or(inside, hn::And(rooms.lanes[i], cc <= Splat(0.0f)));
+        const V disc = b * b - cc;
+        const M ahead = hn::And(rooms.lanes[i], hn::And(b < Splat(0.0f), disc >= Splat(0.0f)));
+        first = Select(ahead, hn::Min(first, hn::Neg(b) - hn::Sqrt(disc)), first);
+      }
+    }
+    return hn::IfThenZeroElse(inside, first);
+  }
+
+  // The gradient of solid k's distance at p by central differences on a tetrahedron.
+  FLATMARCH_PACKET_INLINE void solid_normal(int k, V px, V py, V pz, V& nx, V& ny, V& nz) const {
+    const V h = Splat(params_.normal_step);
+    const V s1 = solid_distance(k, px + h, py - h, pz - h);  // (1, -1, -1)
+    const V s2 = solid_distance(k, px - h, py - h, pz + h);  // (-1, -1, 1)
+    const V s3 = solid_distance(k, px - h, py + h, pz - h);  // (-1, 1, -1)
+    const V s4 = solid_distance(k, px + h, py + h, pz + h);  // (1, 1, 1)
+    const V gx = ((s1 - s2) - s3) + s4;
+    const V gy = ((hn::Neg(s1) - s2) + s3) + s4;
+    const V gz = ((hn::Neg(s1) + s2) - s3) + s4;
+    const V inv = Splat(1.0f) / hn::Sqrt(gx * gx + gy * gy + gz * gz);
+    nx = gx * inv;
+    ny = gy * inv;
+    nz = gz * inv;
+  }
+
+ private:
+  bool has(uint feature) const { return (features_ & feature) != 0u; }
+
+  const ivec4* polygons_;
+  const ObjectRecord* objects_;
+  KernelParams params_;
+  uint features_;
+};
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace flatmarch::simd
+HWY_AFTER_NAMESPACE();
+#endif  // FLATMARCH_BACKENDS_SIMD_SOLIDS_INL_H_

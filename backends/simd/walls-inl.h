@@ -1,0 +1,279 @@
+// The walls of a pass's rooms for packets of rays: distances to them, where rays leave by them,
+// which are opaque, and what a gluing does to the rays that cross one (march.glsl's "Walls").
+// A pass's table reads are one broadcast record per room, or, where a pass spans several rooms,
+// a lookup of each lane's edge in vectors holding the scene's edges.
+
+// Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
+// re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
+#if defined(FLATMARCH_BACKENDS_SIMD_WALLS_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef FLATMARCH_BACKENDS_SIMD_WALLS_INL_H_
+#undef FLATMARCH_BACKENDS_SIMD_WALLS_INL_H_
+#else
+#define FLATMARCH_BACKENDS_SIMD_WALLS_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include <array>
+#include <vector>
+
+#include "backends/simd/lanes-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace flatmarch::simd {
+namespace HWY_NAMESPACE {
+
+class Walls {
+ public:
+  Walls(const kernel::SceneTables<float>& tables, const std::vector<glm::vec4>& edge_extra)
+      : polygons_(tables.polygons.data()),
+        edges_(tables.edges.data()),
+        extra_(edge_extra.data()),
+        params_(tables.params),
+        features_(tables.features) {
+    // Passes over several rooms read the edges by lane from vectors: possible when the scene's
+    // edges fit in one.
+    merge_ = tables.edges.size() <= hn::Lanes(D());
+    if (!merge_) return;
+    for (size_t f = 0; f < kFields; ++f)
+      for (size_t e = 0; e < tables.edges.size(); ++e)
+        lookup_[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], edge_extra[e]);
+    // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
+    for (size_t p = 0; p < tables.polygons.size(); ++p) first_edge_[p] = tables.polygons[p].x;
+    for (size_t e = 0; e < tables.edges.size(); ++e) {
+      const EdgeRecord& edge = tables.edges[e];
+      const ivec4 link = edge.link;
+      const glm::vec4 to = link.x == kEdgeGlued
+                               ? tables
+                                     .edges[static_cast<size_t>(
+                                         tables.polygons[static_cast<size_t>(link.y)].x + link.z)]
+                                     .line
+                               : glm::vec4(0.0f);
+      const std::array<float, kGlueFields> glue{edge.map_shift.x,
+                                                edge.map_shift.y,
+                                                edge.map_linear.x,
+                                                edge.map_linear.y,
+                                                edge.map_linear.z,
+                                                edge.map_linear.w,
+                                                to.x,
+                                                to.y,
+                                                to.z};
+      for (size_t f = 0; f < kGlueFields; ++f) glue_[f][e] = glue[f];
+      to_polygon_[e] = link.x == kEdgeGlued ? link.y : 0;
+      if (link.x == kEdgeGlued && edge.map_linear != glm::vec4(1.0f, 0.0f, 0.0f, 1.0f))
+        translations_ = false;
+    }
+  }
+
+  // Whether a pass may span several rooms (the scene's edges fit in a vector).
+  bool merge() const { return merge_; }
+
+  // Edge k of each lane's room: its index in the edge table (0 where the room has fewer
+  // edges), and the lanes whose room has one.
+  struct Slot {
+    int edge;  // in one room
+    VI edges;  // in several
+    M valid;
+  };
+  template <bool kOneRoom>
+  FLATMARCH_PACKET_INLINE Slot slot(const Rooms& rooms, int k) const {
+    Slot at;
+    if constexpr (kOneRoom) {
+      at.edge = polygons_[rooms.polygon[0]].x + k;
+      at.valid = rooms.lanes[0];
+    } else {
+      at.edge = 0;
+      at.valid = hn::And(rooms.all, hn::RebindMask(D(), SplatI(k) < rooms.edge_count));
+      at.edges = Select(at.valid, rooms.first_edge + SplatI(k), SplatI(0));
+    }
+    return at;
+  }
+
+  // Number `f` of each lane's edge in `at`: in one room a broadcast, in several a lookup in
+  // the scene's edge numbers held in vectors (lookup_).
+  template <bool kOneRoom>
+  FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
+    if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
+    return hn::TableLookupLanes(hn::LoadU(D(), lookup_[f].data()),
+                                hn::IndicesFromVec(D(), at.edges));
+  }
+
+  // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a,
+  // ay_aby = a.y + ab.y.
+  static FLATMARCH_PACKET_INLINE M crosses(V ay, V ay_aby, V abx, V aby, V py, V apx, V apy) {
+    const M over_a = py >= ay;
+    const M under_b = py < ay_aby;
+    const M left = abx * apy > aby * apx;
+    return hn::Or(hn::And(hn::And(over_a, under_b), left),
+                  hn::Not(hn::Or(hn::Or(over_a, under_b), left)));
+  }
+
+  FLATMARCH_PACKET_INLINE M inside_polygon(int polygon, V px, V py) const {
+    const ivec4 poly = polygons_[polygon];
+    M inside = None();
+    for (int k = poly.x; k < poly.x + poly.y; ++k) {
+      const glm::vec4 s = edges_[k].segment;
+      const glm::vec4 x = extra_[k];
+      const V apx = px - Splat(s.x), apy = py - Splat(s.y);
+      inside =
+          hn::Xor(inside, crosses(Splat(s.y), Splat(x.w), Splat(x.x), Splat(x.y), py, apx, apy));
+    }
+    return inside;
+  }
+
+  template <bool kOneRoom>
+  FLATMARCH_PACKET_INLINE WallDistance wall_distance(const Rooms& rooms, V px, V py) const {
+    V best = Splat(kFar), second = Splat(kFar);
+    VI edge = SplatI(-1);
+    M inside = None();
+    for (int k = 0; k < rooms.most_edges; ++k) {
+      const Slot at = slot<kOneRoom>(rooms, k);
+      const M valid = at.valid;
+      const V ax = field<kOneRoom>(at, kAx);
+      const V ay = field<kOneRoom>(at, kAy);
+      const V abx = field<kOneRoom>(at, kAbx);
+      const V aby = field<kOneRoom>(at, kAby);
+      const V w = field<kOneRoom>(at, kInvLength2);
+      const V ay_aby = field<kOneRoom>(at, kAyAby);
+      const V apx = px - ax, apy = py - ay;
+      const V h = hn::Min(hn::Max((apx * abx + apy * aby) * w, Splat(0.0f)), Splat(1.0f));
+      const V qx = apx - h * abx, qy = apy - h * aby;
+      const V d2 = qx * qx + qy * qy;
+      const M nearest = hn::And(valid, d2 < best);
+      second = Select(nearest, best, Select(hn::And(valid, d2 < second), d2, second));
+      best = Select(nearest, d2, best);
+      edge = Select(nearest, SplatI(k), edge);
+      inside = hn::Xor(inside, hn::And(valid, crosses(ay, ay_aby, abx, aby, py, apx, apy)));
+    }
+    WallDistance w;
+    const V root = hn::Sqrt(best);
+    w.d = Select(inside, root, hn::Neg(root));
+    w.edge = edge;
+    w.second = hn::Sqrt(second);
+    return w;
+  }
+
+  // For the rays of `m`; an edge none of them moves towards is skipped.
+  template <bool kOneRoom>
+  FLATMARCH_PACKET_INLINE Exit exit_edge(M m, const Rooms& rooms, V ox, V oy, V dhx, V dhy) const {
+    Exit x;
+    x.s = Splat(kFar);
+    x.edge = SplatI(-1);
+    V u_exit = Splat(0.5f), tolerance_exit = Splat(0.0f);  // of the exit edge found so far
+    const V vertex_tolerance = Splat(params_.vertex_tolerance);
+    for (int k = 0; k < rooms.most_edges; ++k) {
+      const Slot at = slot<kOneRoom>(rooms, k);
+      const V nx = field<kOneRoom>(at, kNx);
+      const V ny = field<kOneRoom>(at, kNy);
+      const V dn = dhx * nx + dhy * ny;
+      const M towards = hn::And(hn::And(m, at.valid), dn > Splat(0.0f));
+      if (!Any(towards)) continue;
+      const V nz = field<kOneRoom>(at, kNa);
+      const V s = (nz - (ox * nx + oy * ny)) / dn;
+      M ok = hn::AndNot(hn::Or(s < hn::Neg(vertex_tolerance), s >= x.s), towards);
+      if (!Any(ok)) continue;  // no ray meets this edge's line before its exit so far
+      const V ax = field<kOneRoom>(at, kAx);
+      const V ay = field<kOneRoom>(at, kAy);
+      const V abx = field<kOneRoom>(at, kAbx);
+      const V aby = field<kOneRoom>(at, kAby);
+      const V w = field<kOneRoom>(at, kInvLength2);
+      const V u = (((ox + s * dhx) - ax) * abx + ((oy + s * dhy) - ay) * aby) * w;
+      const V tolerance = field<kOneRoom>(at, kTolerance);
+      ok =
+          hn::AndNot(hn::Or(hn::Lt(u, hn::Neg(tolerance)), hn::Gt(u, Splat(1.0f) + tolerance)), ok);
+      x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
+      x.edge = Select(ok, SplatI(k), x.edge);
+      u_exit = Select(ok, u, u_exit);
+      tolerance_exit = Select(ok, tolerance, tolerance_exit);
+    }
+    x.corner = hn::Or(u_exit <= tolerance_exit, u_exit >= Splat(1.0f) - tolerance_exit);
+    return x;
+  }
+
+  FLATMARCH_PACKET_INLINE V band_exit(V oz, V dz) const {
+    const M up = dz > Splat(0.0f);
+    const V s = Select(up, Splat(params_.top) - oz, hn::Neg(oz)) / dz;  // one division for both
+    return Select(up, s, Select(dz < Splat(0.0f), s, Splat(kFar)));
+  }
+
+  // Moves p along the normal of an edge's line so that it lies `inside` within it.
+  static FLATMARCH_PACKET_INLINE void place(V& px, V& py, const glm::vec4& line, V inside) {
+    const V nx = Splat(line.x), ny = Splat(line.y);
+    const V k = ((px * nx + py * ny) - Splat(line.z)) + inside;
+    px = px - k * nx;
+    py = py - k * ny;
+  }
+
+  // Which lanes' `edge` of their room is an opaque wall.
+  FLATMARCH_PACKET_INLINE M is_wall(const Rooms& rooms, VI edge) const {
+    M wall = None();
+    if (!has(kFeatureWalls)) return wall;
+    for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
+      const ivec4 poly = polygons_[rooms.polygon[i]];
+      for (int k = 0; k < poly.y; ++k)
+        if (edges_[poly.x + k].link.x == kEdgeWall)
+          wall = hn::Or(wall, hn::And(rooms.lanes[i], Equal(edge, k)));
+    }
+    return wall;
+  }
+
+  // The rays of `m` go through their edge `edge` (of their room, glued) into the glued room and
+  // are placed `push` inside the edge they are then behind: march.glsl's cross_edge when every
+  // edge is glued and the scene's edges fit in a vector (merge()), each lane looking its edge's
+  // gluing up (glue_), all in one round. The caller records the event.
+  FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
+    const DI di;
+    const VI first = hn::TableLookupLanes(hn::LoadU(di, first_edge_.data()),
+                                          hn::IndicesFromVec(di, Select(m, r.polygon, SplatI(0))));
+    const auto at = hn::IndicesFromVec(D(), Select(m, first + edge, SplatI(0)));
+    const auto glue = [&](size_t f) HWY_ATTR {
+      return hn::TableLookupLanes(hn::LoadU(D(), glue_[f].data()), at);
+    };
+    V px, py, hx = r.dx, hy = r.dy, hz = r.dz;
+    if (translations_) {
+      px = r.ox + glue(0);
+      py = r.oy + glue(1);
+    } else {
+      const V mx = glue(2), my = glue(3), mz = glue(4), mw = glue(5);
+      px = (mx * r.ox + mz * r.oy) + glue(0);
+      py = (my * r.ox + mw * r.oy) + glue(1);
+      hx = mx * r.dx + mz * r.dy;
+      hy = my * r.dx + mw * r.dy;
+    }
+    const V nx = glue(6), ny = glue(7);
+    const V k = ((px * nx + py * ny) - glue(8)) + push;  // place
+    px = px - k * nx;
+    py = py - k * ny;
+    if (has(kFeatureScaled)) {  // normalize
+      Normalize(hx, hy, hz);
+    }
+    const VI to = hn::TableLookupLanes(hn::LoadU(di, to_polygon_.data()),
+                                       hn::IndicesFromVec(di, Select(m, first + edge, SplatI(0))));
+    r.polygon = Select(m, to, r.polygon);
+    MoveTo(r, m, px, py, hx, hy, hz);
+    r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
+  }
+
+ private:
+  bool has(uint feature) const { return (features_ & feature) != 0u; }
+
+  const ivec4* polygons_;
+  const EdgeRecord* edges_;
+  const glm::vec4* extra_;  // per edge: b - a (x, y), vertex tolerance in u (z), a.y + (b - a).y
+  bool merge_ = false;      // whether a pass may span several rooms
+  std::array<std::array<float, hn::MaxLanes(D())>, kFields> lookup_{};  // [field][edge]
+  // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
+  // (3); the destination polygon; and whether every gluing is a translation.
+  static constexpr size_t kGlueFields = 9;
+  std::array<std::array<float, hn::MaxLanes(D())>, kGlueFields> glue_{};
+  std::array<int32_t, hn::MaxLanes(DI())> to_polygon_{}, first_edge_{};
+  bool translations_ = true;
+  KernelParams params_;
+  uint features_;
+};
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace flatmarch::simd
+HWY_AFTER_NAMESPACE();
+#endif  // FLATMARCH_BACKENDS_SIMD_WALLS_INL_H_
