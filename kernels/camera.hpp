@@ -6,7 +6,20 @@
 
 #include <glm/glm.hpp>
 
+#include "kernels/constants.hpp"
+
 namespace flatmarch {
+
+namespace kernel {
+// kernels/maths.glsl for plain C++ outside the kernel, in precision `real` (camera_ray here).
+template <typename real>
+struct Maths {
+  using vec2 = typename Types<real>::vec2;
+  using vec3 = typename Types<real>::vec3;
+  using vec4 = typename Types<real>::vec4;
+#include "kernels/maths.glsl"
+};
+}  // namespace kernel
 
 template <typename T>
 struct CameraBasis {
@@ -30,9 +43,8 @@ CameraBasis<T> camera_basis(T yaw_deg, T pitch_deg, T fov_deg, int width, int he
 // Unit direction through the image point (x, y), in pixels from the top left corner.
 template <typename T>
 glm::vec<3, T> camera_ray_at(const CameraBasis<T>& c, T x, T y, int width, int height) {
-  const T u = (T(2) * x / T(width) - T(1)) * c.aspect * c.tan_half_fov;
-  const T v = (T(1) - T(2) * y / T(height)) * c.tan_half_fov;
-  return glm::normalize(c.forward + u * c.right + v * c.up);
+  return kernel::Maths<T>().camera_ray(c.forward, c.right, c.up, c.tan_half_fov, c.aspect,
+                                       glm::vec<2, T>(x, y), glm::vec<2, T>(T(width), T(height)));
 }
 
 // Unit direction of pixel (i, j), row j = 0 at the top: through its centre.

@@ -14,6 +14,9 @@
 #define INOUT(T) T&
 // A constant at file scope (GLSL `const`).
 #define KCONST inline constexpr
+// A function of kernels/maths.glsl: inline, and forced inline where maths.glsl is compiled for
+// packets of rays (backends/simd/maths-inl.h redefines it).
+#define KINLINE inline
 
 namespace flatmarch::kernel {
 
@@ -33,6 +36,14 @@ using glm::mod;
 using glm::normalize;
 using glm::pow;
 using glm::sqrt;
+
+// A condition per ray, and the choice it makes (kernels/maths.glsl): one ray here, one per lane on
+// packets (backends/simd/maths-inl.h).
+using lane_bool = bool;
+template <typename T>
+T select(bool c, T a, T b) {
+  return c ? a : b;
+}
 
 // The vector types of one precision, as the kernel names them.
 template <typename real>

@@ -60,6 +60,7 @@ struct Kernel {
   }
 
 #include "kernels/march.glsl"
+#include "kernels/maths.glsl"
 };
 
 namespace detail {

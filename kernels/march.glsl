@@ -1,7 +1,9 @@
 // The ray-marching kernel of DESIGN.md section 3, written once for every backend in the GLSL
-// subset of kernels/glsl.hpp. It reads the tables of kernels/tables.glsl (`polygons`, `edges`,
-// `objects`, `params`) and calls `record_event`, both provided by whoever includes it; FEATURES
-// is the feature set the kernel is specialised on (kFeature* in kernels/constants.glsl).
+// subset of kernels/glsl.hpp; the maths it does for one ray from numbers already read is in
+// kernels/maths.glsl, which the SIMD backend runs on packets of rays. It reads the tables of
+// kernels/tables.glsl (`polygons`, `edges`, `objects`, `params`) and calls `record_event`, both
+// provided by whoever includes it; FEATURES is the feature set the kernel is specialised on
+// (kFeature* in kernels/constants.glsl).
 //
 // A ray lives in one room at a time: its point `o` and unit direction `d` are in the
 // coordinates of `polygon`. Per iteration only that polygon's edges and solids are evaluated.
@@ -177,13 +179,6 @@ real band_exit(vec3 o, vec3 d) {
   return real(kFar);
 }
 
-// Moves p along the normal of an edge's line so that it lies `inside` within it (negative:
-// beyond it).
-vec2 place(vec2 p, vec4 line, real inside) {
-  vec2 n = vec2(line.x, line.y);
-  return p - (dot(p, n) - line.z + inside) * n;
-}
-
 // A ray at edge k of its polygon goes through it into the glued room, or is reflected by a
 // mirror. Either way its point is then placed `push` inside the edge it is now behind (the
 // paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
@@ -194,17 +189,13 @@ void cross_edge(INOUT(Ray) r, int k, real push) {
   vec2 dh = vec2(r.d);
   if (has(kFeatureMirrors) && edge.link.x == kEdgeMirror) {
     record_event(kEventMirror, r.polygon, k, -1, -1, -1, r.t, r.o);
-    vec2 n = vec2(line.x, line.y);
     r.o = vec3(place(vec2(r.o), line, push), r.o.z);
-    r.d = vec3(dh - real(2) * dot(dh, n) * n, r.d.z);
+    r.d = vec3(mirror_direction(dh, line), r.d.z);
   } else {
     ivec4 link = edge.link;
     record_event(kEventGluing, r.polygon, k, link.y, link.z, -1, r.t, r.o);
-    vec4 m = edge.map_linear;
-    vec4 shift = edge.map_shift;
-    vec2 p = vec2(r.o);
-    p = vec2(m.x * p.x + m.z * p.y, m.y * p.x + m.w * p.y) + vec2(shift.x, shift.y);
-    dh = vec2(m.x * dh.x + m.z * dh.y, m.y * dh.x + m.w * dh.y);
+    vec2 p = glue_point(edge.map_linear, edge.map_shift, vec2(r.o));
+    dh = glue_direction(edge.map_linear, dh);
     r.o = vec3(place(p, edge_at(link.y, link.z).line, push), r.o.z);
     r.d = vec3(dh, r.d.z);
     // Under a map that is not an isometry the direction is renormalised (DESIGN.md section 1).
@@ -233,21 +224,9 @@ void leave_band(INOUT(Ray) r, real s) {
 
 // ---- Solids ----------------------------------------------------------------------------------
 
-// Signed distance from p to solid k of the object table (the paper's SDFs).
+// Signed distance from p to solid k of the object table.
 real solid_distance(int k, vec3 p) {
-  vec4 c = objects[k].center;
-  vec4 shape = objects[k].shape;
-  int solid = objects[k].info.x;
-  vec3 q = p - vec3(c);
-  if (solid == kSolidSphere) return length(q) - shape.x;
-  if (solid == kSolidCylinder) {
-    vec2 w = vec2(length(vec2(q)) - shape.x, abs(q.z) - shape.y);
-    return min(max(w.x, w.y), real(0)) + length(max(w, vec2(real(0))));
-  }
-  vec3 w = abs(q) - vec3(shape);
-  real box = length(max(w, vec3(real(0)))) + min(max(w.x, max(w.y, w.z)), real(0));
-  if (solid == kSolidBox) return box;
-  return max(box, shape.w - length(q));  // hollow cube: the cube minus the sphere
+  return solid_sdf(objects[k].info.x, vec3(objects[k].center), objects[k].shape, p);
 }
 
 struct SolidDistance {
@@ -289,20 +268,10 @@ real solid_entry(int polygon, vec3 o, vec3 d) {
   return inside ? real(0) : first;
 }
 
-// The gradient of the solid's distance by central differences on a tetrahedron.
+// The unit normal of solid k of the object table at p.
 vec3 solid_normal(int k, vec3 p) {
-  real h = params.normal_step;
-  vec3 a = vec3(real(1), real(-1), real(-1));
-  vec3 b = vec3(real(-1), real(-1), real(1));
-  vec3 c = vec3(real(-1), real(1), real(-1));
-  vec3 e = vec3(real(1), real(1), real(1));
-  return normalize(a * solid_distance(k, p + h * a) + b * solid_distance(k, p + h * b) +
-                   c * solid_distance(k, p + h * c) + e * solid_distance(k, p + h * e));
-}
-
-// A solid's own colour when it has one (w > 0), else its normal's (DESIGN.md section 1).
-vec3 solid_surface(vec4 color, vec3 normal) {
-  return color.w > real(0) ? vec3(color) : real(0.5) + real(0.5) * normal;
+  return solid_gradient(objects[k].info.x, vec3(objects[k].center), objects[k].shape, p,
+                        params.normal_step);
 }
 
 // Its normal and colour are left to the end of the march (solid_look): a shader runs all of a
@@ -419,7 +388,8 @@ void find_segment(INOUT(Ray) r, INOUT(Segment) seg) {
 // room, of the band or of max_distance).
 bool near_solid(Ray r, Segment seg) {
   return has(kFeatureObjects) && seg.known &&
-         seg.solids < min(min(seg.exit.s, band_exit(r.o, r.d)), params.max_distance - r.t);
+         seg.solids < min(min(seg.exit.s, band_exit(r.o, r.d)),
+                          params.max_distance - r.t);
 }
 
 // The rest of the room segment: the ray leaves the band, ends, or crosses the exit edge.
@@ -453,8 +423,8 @@ void analytic_step(INOUT(Ray) r, INOUT(Segment) seg) {
     if (solid.d < params.eps) {
       hit_solid(r, solid.object);
       whole = false;
-    } else if (solid.d <
-               min(min(seg.exit.s, band_exit(r.o, r.d)), params.max_distance - r.t)) {
+    } else if (solid.d < min(min(seg.exit.s, band_exit(r.o, r.d)),
+                             params.max_distance - r.t)) {
       move_in_segment(r, seg, solid.d);
       whole = false;
     }

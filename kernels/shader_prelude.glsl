@@ -4,6 +4,13 @@
 #define INOUT(T) inout T
 #define FLATMARCH_SHADER
 
+// A condition per ray, and the choice it makes (kernels/maths.glsl).
+#define lane_bool bool
+#define KINLINE
+vec3 select(bool c, vec3 a, vec3 b) {
+  return c ? a : b;
+}
+
 #ifdef FLATMARCH_TRACE
 // A probe ray's transport trace: one invocation marches it and appends its events here.
 struct EventRecord {

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "backends/simd/lanes-inl.h"
+#include "backends/simd/maths-inl.h"
 #include "backends/simd/solids-inl.h"
 #include "backends/simd/walls-inl.h"
 
@@ -189,38 +190,34 @@ class Marcher {
       const M mk = hn::And(left, hn::And(Equal(edge, k), Equal(r.polygon, polygon)));
       left = hn::AndNot(mk, left);
       const EdgeRecord& e = edges_[polygons_[polygon].x + k];
-      V px = r.ox, py = r.oy;
-      V hx = r.dx, hy = r.dy, hz = r.dz;
+      const lane::vec2 o(r.ox, r.oy), d(r.dx, r.dy);
+      lane::vec2 p = o, h = d;
+      V hz = r.dz;
       if (has(kFeatureMirrors) && e.link.x == kEdgeMirror) {
         record(mk, kEventMirror, r.polygon, SplatI(k), -1, -1, SplatI(-1), r);
-        const V nx = Splat(e.line.x), ny = Splat(e.line.y);
-        Walls::place(px, py, e.line, push);
-        const V twice = Splat(2.0f) * (hx * nx + hy * ny);
-        hx = hx - twice * nx;
-        hy = hy - twice * ny;
+        const lane::vec4 line = lane::Broadcast(e.line);
+        p = lane::place(o, line, push);
+        h = lane::mirror_direction(d, line);
       } else {
         const ivec4 link = e.link;
         record(mk, kEventGluing, r.polygon, SplatI(k), link.y, link.z, SplatI(-1), r);
-        const glm::vec4 a = e.map_linear;
-        if (a == glm::vec4(1.0f, 0.0f, 0.0f, 1.0f)) {  // a translation: what the map gives
-          px = r.ox + Splat(e.map_shift.x);
-          py = r.oy + Splat(e.map_shift.y);
-        } else {
-          const V mx = Splat(a.x), my = Splat(a.y), mz = Splat(a.z), mw = Splat(a.w);
-          px = (mx * r.ox + mz * r.oy) + Splat(e.map_shift.x);
-          py = (my * r.ox + mw * r.oy) + Splat(e.map_shift.y);
-          hx = mx * r.dx + mz * r.dy;
-          hy = my * r.dx + mw * r.dy;
-        }
-        Walls::place(px, py, edges_[polygons_[link.y].x + link.z].line, push);
-        if (has(kFeatureScaled)) {  // normalize
-          Normalize(hx, hy, hz);
-        }
+        const lane::vec4 linear = lane::Broadcast(e.map_linear);
+        p = lane::place(lane::glue_point(linear, lane::Broadcast(e.map_shift), o),
+                        lane::Broadcast(edges_[polygons_[link.y].x + link.z].line), push);
+        h = lane::glue_direction(linear, d);
+        if (has(kFeatureScaled)) Normalize(h.x.v, h.y.v, hz);
         r.polygon = Select(mk, SplatI(link.y), r.polygon);
       }
-      MoveTo(r, mk, px, py, hx, hy, hz);
+      MoveTo(r, mk, p.x.v, p.y.v, h.x.v, h.y.v, hz);
     }
     r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
+  }
+
+  // Distance along each ray to where it leaves the band.
+  FLATMARCH_PACKET_INLINE V band_exit(const Packet& r) const {
+    const M up = r.dz > Splat(0.0f);
+    const V s = Select(up, Splat(params_.top) - r.oz, hn::Neg(r.oz)) / r.dz;
+    return Select(up, s, Select(r.dz < Splat(0.0f), s, Splat(kFar)));
   }
 
   // The rays of `m` reach the top or bottom of the band, `s` further on.
@@ -246,16 +243,14 @@ class Marcher {
       const int k = lane_objects[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
       const M mk = hn::And(left, Equal(object, k));
       left = hn::AndNot(mk, left);
-      V nx, ny, nz;
-      solids_.solid_normal(k, r.ox, r.oy, r.oz, nx, ny, nz);
-      r.nx = Select(mk, nx, r.nx);
-      r.ny = Select(mk, ny, r.ny);
-      r.nz = Select(mk, nz, r.nz);
-      const glm::vec4 c = objects_[k].color;
-      const V half = Splat(0.5f);
-      r.sr = Select(mk, c.w > 0.0f ? Splat(c.x) : half + half * nx, r.sr);
-      r.sg = Select(mk, c.w > 0.0f ? Splat(c.y) : half + half * ny, r.sg);
-      r.sb = Select(mk, c.w > 0.0f ? Splat(c.z) : half + half * nz, r.sb);
+      const lane::vec3 n = solids_.solid_normal(k, r.ox, r.oy, r.oz);
+      const lane::vec3 surface = lane::solid_surface(lane::Broadcast(objects_[k].color), n);
+      r.nx = Select(mk, n.x.v, r.nx);
+      r.ny = Select(mk, n.y.v, r.ny);
+      r.nz = Select(mk, n.z.v, r.nz);
+      r.sr = Select(mk, surface.x.v, r.sr);
+      r.sg = Select(mk, surface.y.v, r.sg);
+      r.sb = Select(mk, surface.z.v, r.sb);
       finish(r, mk, SplatI(objects_[k].info.y), kEventObject, SplatI(-1), Splat(0.0f));
     }
   }
@@ -305,7 +300,7 @@ class Marcher {
       rest = hn::AndNot(near, rest);
     }
     const V safe = hn::Abs(radius);
-    const V band = walls_.band_exit(r.oz, r.dz);
+    const V band = band_exit(r);
     const V remaining = Splat(params_.max_distance) - r.t;
     const M far = hn::And(rest, remaining <= hn::Min(safe, band));
     finish(r, far, SplatI(kHitMaxDistance), kEventMaxDistance, SplatI(-1), remaining);
@@ -345,13 +340,13 @@ class Marcher {
     }
     const V max_distance = Splat(params_.max_distance);
     V remaining = max_distance - r.t;
-    V band = walls_.band_exit(r.oz, r.dz);  // recomputed below for the rays that move
+    V band = band_exit(r);  // recomputed below for the rays that move
     M rest = m;
     if (has(kFeatureObjects)) {
       const M solids = hn::And(m, seg.solids < hn::Min(hn::Min(seg.exit.s, band), remaining));
       if (Any(solids)) {
         move_in_segment(r, seg, solids, seg.solids);
-        band = Select(solids, walls_.band_exit(r.oz, r.dz), band);
+        band = Select(solids, band_exit(r), band);
         const SolidDistance solid = solids_.nearest_solid(rooms, r.ox, r.oy, r.oz);
         const M hit = hn::And(solids, solid.d < Splat(params_.eps));
         hit_solid(r, hit, solid.object);

@@ -21,6 +21,7 @@
 // Per-target parts (after foreach_target.h, as it re-includes this file for each target).
 #include "backends/simd/lanes-inl.h"
 #include "backends/simd/marcher-inl.h"
+#include "backends/simd/maths-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
@@ -78,22 +79,19 @@ int PacketLanes() {
   return static_cast<int>(hn::Lanes(D()));
 }
 
-// camera_ray for each lane's pixel (i, j): through the pixel's centre, normalised.
+// maths.glsl's camera_ray for each lane's pixel (i, j): through the pixel's centre.
 HWY_INLINE void CameraRays(const PacketJob& job, const int32_t* i, const int32_t* j, V& dx, V& dy,
                            V& dz) {
   const DI di;
   const CameraBasis<float>& c = job.basis;
-  const V px = hn::ConvertTo(D(), hn::LoadU(di, i)) + Splat(0.5f);
-  const V py = hn::ConvertTo(D(), hn::LoadU(di, j)) + Splat(0.5f);
-  const V u =
-      ((Splat(2.0f) * px / Splat(static_cast<float>(job.width)) - Splat(1.0f)) * Splat(c.aspect)) *
-      Splat(c.tan_half_fov);
-  const V v = (Splat(1.0f) - Splat(2.0f) * py / Splat(static_cast<float>(job.height))) *
-              Splat(c.tan_half_fov);
-  dx = (Splat(c.forward.x) + u * Splat(c.right.x)) + v * Splat(c.up.x);
-  dy = (Splat(c.forward.y) + u * Splat(c.right.y)) + v * Splat(c.up.y);
-  dz = (Splat(c.forward.z) + u * Splat(c.right.z)) + v * Splat(c.up.z);
-  Normalize(dx, dy, dz);
+  const lane::vec2 at(hn::ConvertTo(D(), hn::LoadU(di, i)) + Splat(0.5f),
+                      hn::ConvertTo(D(), hn::LoadU(di, j)) + Splat(0.5f));
+  const lane::vec2 size(static_cast<float>(job.width), static_cast<float>(job.height));
+  const lane::vec3 d = lane::camera_ray(lane::Broadcast(c.forward), lane::Broadcast(c.right),
+                                        lane::Broadcast(c.up), c.tan_half_fov, c.aspect, at, size);
+  dx = d.x.v;
+  dy = d.y.v;
+  dz = d.z.v;
 }
 
 // Lanes wait for a new pixel until this many eighths of them do: refilling costs a shading and a

@@ -13,6 +13,7 @@
 #include <hwy/highway.h>
 
 #include "backends/simd/lanes-inl.h"
+#include "backends/simd/maths-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
@@ -26,6 +27,8 @@ class Solids {
         params_(tables.params),
         features_(tables.features) {}
 
+  // Signed distance from p to solid k of the object table: maths.glsl's solid_sdf, spelled out
+  // (as solid_sdf over lane::vec3 it made sphere tracing 15% slower, L-shape and torus, 2 cores).
   FLATMARCH_PACKET_INLINE V solid_distance(int k, V px, V py, V pz) const {
     const ObjectRecord& o = objects_[k];
     const V qx = px - Splat(o.center.x), qy = py - Splat(o.center.y);
@@ -86,20 +89,12 @@ class Solids {
     return hn::IfThenZeroElse(inside, first);
   }
 
-  // The gradient of solid k's distance at p by central differences on a tetrahedron.
-  FLATMARCH_PACKET_INLINE void solid_normal(int k, V px, V py, V pz, V& nx, V& ny, V& nz) const {
-    const V h = Splat(params_.normal_step);
-    const V s1 = solid_distance(k, px + h, py - h, pz - h);  // (1, -1, -1)
-    const V s2 = solid_distance(k, px - h, py - h, pz + h);  // (-1, -1, 1)
-    const V s3 = solid_distance(k, px - h, py + h, pz - h);  // (-1, 1, -1)
-    const V s4 = solid_distance(k, px + h, py + h, pz + h);  // (1, 1, 1)
-    const V gx = ((s1 - s2) - s3) + s4;
-    const V gy = ((hn::Neg(s1) - s2) + s3) + s4;
-    const V gz = ((hn::Neg(s1) + s2) - s3) + s4;
-    const V inv = Splat(1.0f) / hn::Sqrt(gx * gx + gy * gy + gz * gz);
-    nx = gx * inv;
-    ny = gy * inv;
-    nz = gz * inv;
+  // The unit normal of solid k of the object table at p (maths.glsl's solid_gradient).
+  FLATMARCH_PACKET_INLINE lane::vec3 solid_normal(int k, V px, V py, V pz) const {
+    const ObjectRecord& o = objects_[k];
+    return lane::solid_gradient(o.info.x, lane::vec3(lane::Broadcast(o.center)),
+                                lane::Broadcast(o.shape), lane::vec3(px, py, pz),
+                                params_.normal_step);
   }
 
  private:

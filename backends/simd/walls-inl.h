@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "backends/simd/lanes-inl.h"
+#include "backends/simd/maths-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
@@ -60,8 +61,6 @@ class Walls {
                                                 to.z};
       for (size_t f = 0; f < kGlueFields; ++f) glue_[f][e] = glue[f];
       to_polygon_[e] = link.x == kEdgeGlued ? link.y : 0;
-      if (link.x == kEdgeGlued && edge.map_linear != glm::vec4(1.0f, 0.0f, 0.0f, 1.0f))
-        translations_ = false;
     }
   }
 
@@ -190,20 +189,6 @@ class Walls {
     return x;
   }
 
-  FLATMARCH_PACKET_INLINE V band_exit(V oz, V dz) const {
-    const M up = dz > Splat(0.0f);
-    const V s = Select(up, Splat(params_.top) - oz, hn::Neg(oz)) / dz;  // one division for both
-    return Select(up, s, Select(dz < Splat(0.0f), s, Splat(kFar)));
-  }
-
-  // Moves p along the normal of an edge's line so that it lies `inside` within it.
-  static FLATMARCH_PACKET_INLINE void place(V& px, V& py, const glm::vec4& line, V inside) {
-    const V nx = Splat(line.x), ny = Splat(line.y);
-    const V k = ((px * nx + py * ny) - Splat(line.z)) + inside;
-    px = px - k * nx;
-    py = py - k * ny;
-  }
-
   // Which lanes' `edge` of their room is an opaque wall.
   FLATMARCH_PACKET_INLINE M is_wall(const Rooms& rooms, VI edge) const {
     M wall = None();
@@ -229,24 +214,14 @@ class Walls {
     const auto glue = [&](size_t f) HWY_ATTR {
       return hn::TableLookupLanes(hn::LoadU(D(), glue_[f].data()), at);
     };
-    V px, py, hx = r.dx, hy = r.dy, hz = r.dz;
-    if (translations_) {
-      px = r.ox + glue(0);
-      py = r.oy + glue(1);
-    } else {
-      const V mx = glue(2), my = glue(3), mz = glue(4), mw = glue(5);
-      px = (mx * r.ox + mz * r.oy) + glue(0);
-      py = (my * r.ox + mw * r.oy) + glue(1);
-      hx = mx * r.dx + mz * r.dy;
-      hy = my * r.dx + mw * r.dy;
-    }
-    const V nx = glue(6), ny = glue(7);
-    const V k = ((px * nx + py * ny) - glue(8)) + push;  // place
-    px = px - k * nx;
-    py = py - k * ny;
-    if (has(kFeatureScaled)) {  // normalize
-      Normalize(hx, hy, hz);
-    }
+    const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
+    const lane::vec4 shift{glue(0), glue(1), 0.0f, 0.0f};
+    const lane::vec4 to_line{glue(6), glue(7), glue(8), 0.0f};
+    const lane::vec2 p =
+        lane::place(lane::glue_point(linear, shift, lane::vec2(r.ox, r.oy)), to_line, push);
+    const lane::vec2 dh = lane::glue_direction(linear, lane::vec2(r.dx, r.dy));
+    V px = p.x.v, py = p.y.v, hx = dh.x.v, hy = dh.y.v, hz = r.dz;
+    if (has(kFeatureScaled)) Normalize(hx, hy, hz);
     const VI to = hn::TableLookupLanes(hn::LoadU(di, to_polygon_.data()),
                                        hn::IndicesFromVec(di, Select(m, first + edge, SplatI(0))));
     r.polygon = Select(m, to, r.polygon);
@@ -263,11 +238,10 @@ class Walls {
   bool merge_ = false;      // whether a pass may span several rooms
   std::array<std::array<float, hn::MaxLanes(D())>, kFields> lookup_{};  // [field][edge]
   // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
-  // (3); the destination polygon; and whether every gluing is a translation.
+  // (3); and the destination polygon.
   static constexpr size_t kGlueFields = 9;
   std::array<std::array<float, hn::MaxLanes(D())>, kGlueFields> glue_{};
   std::array<int32_t, hn::MaxLanes(DI())> to_polygon_{}, first_edge_{};
-  bool translations_ = true;
   KernelParams params_;
   uint features_;
 };
