@@ -71,13 +71,6 @@ HWY_INLINE M Select(M m, M a, M b) {
 HWY_INLINE bool Any(M m) {
   return !hn::AllFalse(D(), m);
 }
-// (x, y, z) scaled to length 1, as GLSL's normalize (one division, three products).
-HWY_INLINE void Normalize(V& x, V& y, V& z) {
-  const V inv = Splat(1.0f) / hn::Sqrt(x * x + y * y + z * z);
-  x = x * inv;
-  y = y * inv;
-  z = z * inv;
-}
 
 // What a packet of rays is doing (march.glsl's Ray, one lane per ray).
 struct Packet {

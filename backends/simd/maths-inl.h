@@ -148,6 +148,14 @@ HWY_INLINE vec3 select(lane_bool c, const vec3& a, const vec3& b) {
 #define KINLINE inline
 
 }  // namespace lane
+
+// (x, y, z) scaled to length 1: lane::normalize on three vectors.
+HWY_INLINE void Normalize(V& x, V& y, V& z) {
+  const lane::vec3 n = lane::normalize(lane::vec3(x, y, z));
+  x = n.x.v;
+  y = n.y.v;
+  z = n.z.v;
+}
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
 }  // namespace flatmarch::simd
