@@ -1,9 +1,11 @@
 // The SIMD backend at 640x360 from each scene's own camera: rays per second and lane utilisation
 // (active lanes over lanes, summed over every pass of every packet step), per gallery scene and
-// method, on all cores with the best instruction set here. For the L-shape and the double
-// pentagon it also runs, side by side in one run, the scalar backend, the SIMD backend on one
-// thread, and every instruction set on one thread: bench/speedups.py turns the JSON into the
-// ratios (SIMD on all cores over scalar, all cores over one thread).
+// method, on all cores with the best instruction set here, and on staircases of 4, 32 and 128
+// squares (reports/surfaces.hpp; rays run to max_distance 40), where rays spread over many rooms.
+// For the L-shape and the double pentagon it also runs, side by side in one run, the scalar
+// backend, the SIMD backend on one thread, and every instruction set on one thread; for the cube
+// and the 32-square staircase the scalar backend: bench/speedups.py turns the JSON into the ratios
+// (SIMD on all cores over scalar, all cores over one thread).
 //
 //   simd_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //              --benchmark_out=simd.json --benchmark_out_format=json   (one line)
@@ -20,6 +22,7 @@
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/simd.hpp"
 #include "bench/gallery.hpp"
+#include "reports/surfaces.hpp"
 
 namespace flatmarch {
 namespace {
@@ -58,7 +61,9 @@ int main(int argc, char** argv) {
   using namespace flatmarch;
   if (!bench::begin(argc, argv)) return 2;
 
-  const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
+  std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
+  for (int squares : {4, 32, 128})  // named staircase_N
+    scenes.push_back(std::make_unique<Scene>(reports::staircase_surface(squares)));
   const std::vector<std::string> isas = simd::isa_names(true);
   const int cores = tbb::info::default_concurrency();
   std::cerr << "simd_bench: " << cores << " cores; instruction sets here:";
@@ -69,6 +74,7 @@ int main(int argc, char** argv) {
                              int threads) {
     MarchParams params;
     params.method = method;
+    if (scene->name.rfind("staircase_", 0) == 0) params.max_distance = 40.0;
     const std::string name = std::string("simd/") + to_string(method) + "/" + scene->name + "/" +
                              isa + "/threads:" + std::to_string(threads);
     BackendOptions options;
@@ -81,16 +87,18 @@ int main(int argc, char** argv) {
   for (Method method : {Method::sphere, Method::relaxed, Method::analytic}) {
     for (const auto& scene : scenes) {
       const bool compared = scene->name == "l_shape" || scene->name == "double_pentagon";
-      if (compared) {
+      if (compared || scene->name == "cube" || scene->name == "staircase_32") {
         MarchParams params;
         params.method = method;
+        if (scene->name == "staircase_32") params.max_distance = 40.0;
         benchmark::RegisterBenchmark(
             (std::string("scalar/") + to_string(method) + "/" + scene->name).c_str(), scalar_frame,
             scene.get(), params)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
-        for (const std::string& isa : isas) simd_case(scene.get(), method, isa, 1);
       }
+      if (compared)
+        for (const std::string& isa : isas) simd_case(scene.get(), method, isa, 1);
       if (!compared || cores > 1) simd_case(scene.get(), method, isas.front(), cores);
     }
   }

@@ -11,6 +11,7 @@
 
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/simd.hpp"
+#include "reports/surfaces.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
 
@@ -102,6 +103,28 @@ TEST(Simd, EveryInstructionSetAgreesWithScalar) {
         EXPECT_EQ(simd.isa(), isa);
         const Agreement n = compare(scalar, simd.render(scene, scene.camera, 90, 50, params, {}));
         expect_identical(n, std::string(name) + " " + isa);
+      }
+    }
+  }
+}
+
+// Rays spread over many rooms: staircases whose edges do not fit in a vector, so that a pass
+// over several rooms blends their edges by lane (32 and 128 squares: 128 and 512 edges, more
+// rooms among a packet's rays than a pass takes), or takes one room a pass (130 squares: 520
+// edges, over what the blend's tables hold). Every instruction set gives the scalar frame.
+TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
+  for (int squares : {32, 128, 130}) {
+    const Scene scene = reports::staircase_surface(squares);
+    for (Method m : {Method::sphere, Method::analytic}) {
+      MarchParams params;
+      params.method = m;
+      params.max_distance = 40.0;
+      const Frame scalar = ScalarBackend().render(scene, scene.camera, 64, 36, params, {});
+      for (const std::string& isa : simd::isa_names(true)) {
+        const Agreement n = compare(
+            scalar, SimdBackend({.isa = isa}).render(scene, scene.camera, 64, 36, params, {}));
+        expect_identical(n,
+                         "staircase " + std::to_string(squares) + " " + to_string(m) + " " + isa);
       }
     }
   }

@@ -103,6 +103,7 @@ class Marcher {
     std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
     hn::StoreU(r.polygon, DI(), lane_rooms.data());
     M pending = active;
+    const bool analytic = params_.method == kMethodAnalytic;
     while (Any(pending)) {
       Rooms rooms;
       M pass = None();
@@ -123,7 +124,6 @@ class Marcher {
       rooms.all = pass;
       lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
       lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
-      const bool analytic = params_.method == kMethodAnalytic;
       if (rooms.count == 1 && analytic)
         analytic_step<true>(r, seg, pass, rooms);
       else if (rooms.count == 1)
@@ -172,7 +172,7 @@ class Marcher {
   // The rays of `m` at their edge `edge` (of their room) go through it or are reflected, and are
   // placed `push` inside the edge they are then behind. One broadcast record per edge.
   FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, VI edge, V push) const {
-    if (walls_.merge() && !has(kFeatureMirrors)) {
+    if (walls_.glue_by_lane() && !has(kFeatureMirrors)) {
       if (events_ && !hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1)))) {
         const ivec4 link = edges_[polygons_[hn::GetLane(r.polygon)].x + hn::GetLane(edge)].link;
         record(m, kEventGluing, r.polygon, edge, link.y, link.z, SplatI(-1), r);

@@ -14,6 +14,7 @@
 
 #include <hwy/highway.h>
 
+#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -32,16 +33,26 @@ class Walls {
         extra_(edge_extra.data()),
         params_(tables.params),
         features_(tables.features) {
-    // Passes over several rooms read the edges by lane from vectors: possible when the scene's
-    // edges fit in one.
-    merge_ = tables.edges.size() <= hn::Lanes(D());
-    if (!merge_) return;
-    for (size_t f = 0; f < kFields; ++f)
-      for (size_t e = 0; e < tables.edges.size(); ++e)
+    // Passes over several rooms read each lane's edge from the scene's edge numbers: by a lookup
+    // in one vector when the edges fit in one, else by a broadcast per room blended by lane
+    // (cheaper than a gather), for scenes of up to kMostEdges edges.
+    const size_t edges = tables.edges.size();
+    mode_ = edges <= hn::Lanes(D()) ? kTable : edges <= kMostEdges ? kBlend : kSingle;
+    if (mode_ == kSingle) return;
+    // Zero up to a whole vector, for the lookup's load.
+    const size_t filled = std::max(edges, hn::Lanes(D()));
+    for (size_t f = 0; f < kFields; ++f) {
+      std::fill_n(lookup_[f].begin(), filled, 0.0f);
+      for (size_t e = 0; e < edges; ++e)
         lookup_[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], edge_extra[e]);
+    }
+    if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
+    std::fill_n(first_edge_.begin(), std::max(tables.polygons.size(), hn::Lanes(D())), 0);
     for (size_t p = 0; p < tables.polygons.size(); ++p) first_edge_[p] = tables.polygons[p].x;
-    for (size_t e = 0; e < tables.edges.size(); ++e) {
+    for (auto& g : glue_) std::fill_n(g.begin(), filled, 0.0f);
+    std::fill_n(to_polygon_.begin(), filled, 0);
+    for (size_t e = 0; e < edges; ++e) {
       const EdgeRecord& edge = tables.edges[e];
       const ivec4 link = edge.link;
       const glm::vec4 to = link.x == kEdgeGlued
@@ -64,8 +75,12 @@ class Walls {
     }
   }
 
-  // Whether a pass may span several rooms (the scene's edges fit in a vector).
-  bool merge() const { return merge_; }
+  // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
+  bool merge() const { return mode_ != kSingle; }
+  // Whether crossings look each lane's gluing up in vectors (cross_glued). Where the edges do
+  // not fit in one, a crossing takes a round per edge crossed: a gather of each lane's gluing
+  // made the cube's and the staircases' analytic frames 1.4-1.5x slower (measured).
+  bool glue_by_lane() const { return mode_ == kTable; }
 
   // Edge k of each lane's room: its index in the edge table (0 where the room has fewer
   // edges), and the lanes whose room has one.
@@ -73,10 +88,14 @@ class Walls {
     int edge;  // in one room
     VI edges;  // in several
     M valid;
+    int k;               // the slot's number in each room
+    const Rooms* rooms;  // in several
   };
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE Slot slot(const Rooms& rooms, int k) const {
     Slot at;
+    at.k = k;
+    at.rooms = &rooms;
     if constexpr (kOneRoom) {
       at.edge = polygons_[rooms.polygon[0]].x + k;
       at.valid = rooms.lanes[0];
@@ -89,12 +108,19 @@ class Walls {
   }
 
   // Number `f` of each lane's edge in `at`: in one room a broadcast, in several a lookup in
-  // the scene's edge numbers held in vectors (lookup_).
+  // the scene's edge numbers (lookup_).
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
     if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
-    return hn::TableLookupLanes(hn::LoadU(D(), lookup_[f].data()),
-                                hn::IndicesFromVec(D(), at.edges));
+    if (mode_ == kTable) return lookup(D(), lookup_[f], at.edges);
+    // The few rooms' numbers broadcast and blended: cheaper than a gather.
+    V v = Splat(0.0f);
+    for (size_t i = 0; i < static_cast<size_t>(at.rooms->count); ++i) {
+      const ivec4 poly = polygons_[at.rooms->polygon[i]];
+      if (at.k < poly.y)
+        v = Select(at.rooms->lanes[i], Splat(lookup_[f][static_cast<size_t>(poly.x + at.k)]), v);
+    }
+    return v;
   }
 
   // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a,
@@ -208,12 +234,9 @@ class Walls {
   // gluing up (glue_), all in one round. The caller records the event.
   FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
     const DI di;
-    const VI first = hn::TableLookupLanes(hn::LoadU(di, first_edge_.data()),
-                                          hn::IndicesFromVec(di, Select(m, r.polygon, SplatI(0))));
-    const auto at = hn::IndicesFromVec(D(), Select(m, first + edge, SplatI(0)));
-    const auto glue = [&](size_t f) HWY_ATTR {
-      return hn::TableLookupLanes(hn::LoadU(D(), glue_[f].data()), at);
-    };
+    const VI first = lookup(di, first_edge_, Select(m, r.polygon, SplatI(0)));
+    const VI at = Select(m, first + edge, SplatI(0));
+    const auto glue = [&](size_t f) HWY_ATTR { return lookup(D(), glue_[f], at); };
     const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
     const lane::vec4 shift{glue(0), glue(1), 0.0f, 0.0f};
     const lane::vec4 to_line{glue(6), glue(7), glue(8), 0.0f};
@@ -222,8 +245,7 @@ class Walls {
     const lane::vec2 dh = lane::glue_direction(linear, lane::vec2(r.dx, r.dy));
     V px = p.x.v, py = p.y.v, hx = dh.x.v, hy = dh.y.v, hz = r.dz;
     if (has(kFeatureScaled)) Normalize(hx, hy, hz);
-    const VI to = hn::TableLookupLanes(hn::LoadU(di, to_polygon_.data()),
-                                       hn::IndicesFromVec(di, Select(m, first + edge, SplatI(0))));
+    const VI to = lookup(di, to_polygon_, at);
     r.polygon = Select(m, to, r.polygon);
     MoveTo(r, m, px, py, hx, hy, hz);
     r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
@@ -235,13 +257,26 @@ class Walls {
   const ivec4* polygons_;
   const EdgeRecord* edges_;
   const glm::vec4* extra_;  // per edge: b - a (x, y), vertex tolerance in u (z), a.y + (b - a).y
-  bool merge_ = false;      // whether a pass may span several rooms
-  std::array<std::array<float, hn::MaxLanes(D())>, kFields> lookup_{};  // [field][edge]
+  // The tables are arrays in the object, not on the heap: with std::vector the frames of the
+  // torus and the L-shape, which never read them, were 10-20% slower (measured).
+  static constexpr size_t kMostEdges = 512;
+  template <typename T>
+  using Table = std::array<T, kMostEdges>;
+
+  // Entry `index` of `table` for each lane, the table held in one vector (kTable).
+  template <class DT, typename T>
+  FLATMARCH_PACKET_INLINE hn::Vec<DT> lookup(DT d, const Table<T>& table, VI index) const {
+    return hn::TableLookupLanes(hn::LoadU(d, table.data()), hn::IndicesFromVec(d, index));
+  }
+
+  // How a pass over several rooms reads its lanes' edges.
+  enum Mode { kSingle, kTable, kBlend } mode_ = kSingle;
+  std::array<Table<float>, kFields> lookup_;  // [field][edge]
   // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
   // (3); and the destination polygon.
   static constexpr size_t kGlueFields = 9;
-  std::array<std::array<float, hn::MaxLanes(D())>, kGlueFields> glue_{};
-  std::array<int32_t, hn::MaxLanes(DI())> to_polygon_{}, first_edge_{};
+  std::array<Table<float>, kGlueFields> glue_;
+  Table<int32_t> to_polygon_, first_edge_;
   KernelParams params_;
   uint features_;
 };
