@@ -96,8 +96,10 @@ class Marcher {
   // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
   // of the rays that have taken max_steps. A step runs in passes of up to kRoomsPerPass rooms
   // (usually one pass); the rays a pass moves to another room are already out of `pending`.
-  FLATMARCH_PACKET_INLINE void step(Packet& r, Relaxation& x, Segment& seg,
-                                    LaneCounts& lanes) const {
+  // Returns the rooms its passes went over, summed.
+  FLATMARCH_PACKET_INLINE int step(Packet& r, Relaxation& x, Segment& seg,
+                                   LaneCounts& lanes) const {
+    int rooms_seen = 0;
     const M active = hn::Not(r.done);
     r.steps = Select(active, r.steps + SplatI(1), r.steps);
     std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
@@ -133,9 +135,11 @@ class Marcher {
       else
         sphere_step<false>(r, x, pass, rooms);
       pending = hn::AndNot(pass, pending);
+      rooms_seen += rooms.count;
     }
     const M out = hn::AndNot(r.done, hn::RebindMask(D(), r.steps == SplatI(params_.max_steps)));
     finish(r, out, SplatI(kHitMaxSteps), kEventMaxSteps, SplatI(-1), Splat(0.0f));
+    return rooms_seen;
   }
 
  private:
