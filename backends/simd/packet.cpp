@@ -103,13 +103,13 @@ HWY_INLINE void CameraRays(const PacketJob& job, const int32_t* i, const int32_t
 // 52.1; a recheck in three interleaved rounds: the L-shape up to 5% slower, within this machine's
 // noise); 5/8 loses 18% on the L-shape's sphere tracing, 1/8 spends more on refills than it gains.
 constexpr size_t kRefillAt = 4;
-// While the packet's rays are in several rooms (its last step passed over more than one), lanes
-// wait until six eighths of them can take a pixel: the rays refilled together start together in
-// the camera's room, and the packet stays in fewer rooms. Against 4/8 there, 640x360, 2 cores,
-// AVX-512, best of 2 rounds: 32-square staircase analytic 27.7 -> 23.2 ms, sphere 592 -> 561;
-// 4-square staircase analytic 18.6 -> 17.4, sphere 405 -> 425; cube 2% faster; the L-shape,
-// double pentagon, torus, pillowcase and L-shape prism within 5% either way. 8/8 gained a little
-// more on the 32-square staircase (22.1, 533) and lost 8% on the 4-square one's sphere tracing.
+// For the analytic method, while the packet's rays are spread over rooms (its last step passed
+// over more than two), lanes wait until six eighths of them can take a pixel: refilled rays start
+// together in the camera's room, and the packet stays in fewer rooms. Against 4/8 everywhere,
+// 640x360, 2 cores, AVX-512, best of 2 rounds: 32- and 128-square staircases 27.0 -> 24.2 and
+// 27.5 -> 24.6 ms, every gallery scene within 4% either way. Sphere tracing gained 1-4% on the
+// 32-square staircase with fewer lanes busy (0.96 -> 0.82), and over more than one room (not
+// two) lost 5-8% on the 4-square staircase and the double pentagon: it keeps 4/8.
 constexpr size_t kRefillSpread = 6;
 
 // Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
@@ -139,7 +139,8 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   // Every iteration steps at least one ray, and a ray takes at most max_steps steps.
   const int64_t bound = queue * (int64_t{job.tables->params.max_steps} + 1) + 1;
   M occupied = None();  // lanes holding a pixel
-  bool spread = false;
+  const bool analytic = job.tables->params.method == kMethodAnalytic;
+  bool spread = false;  // the analytic method's rays over several rooms (kRefillSpread)
   for (int64_t iteration = 0; iteration < bound; ++iteration) {
     // Lanes are refilled once enough of them wait, or when none is left marching.
     const M waiting = next < queue ? r.done : hn::And(r.done, occupied);
@@ -193,7 +194,8 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       continue;  // a ray may end as it starts (a miss): write it out before stepping
     }
     if (hn::AllTrue(D(), r.done)) break;  // no pixels left and every ray written
-    spread = marcher.step(r, x, seg, *lanes) > 1;
+    const int rooms = marcher.step(r, x, seg, *lanes);
+    spread = analytic && rooms > 2;
   }
 }
 
