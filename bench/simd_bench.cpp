@@ -44,6 +44,15 @@ void simd_frame(benchmark::State& state, const Scene* scene, MarchParams params,
   state.counters["lanes"] = simd.lanes();
 }
 
+// The march parameters of a case: the defaults with `method`; staircases' rays run to
+// max_distance 40 (they never meet anything).
+MarchParams case_params(const Scene& scene, Method method) {
+  MarchParams params;
+  params.method = method;
+  if (scene.name.rfind("staircase_", 0) == 0) params.max_distance = 40.0;
+  return params;
+}
+
 void scalar_frame(benchmark::State& state, const Scene* scene, MarchParams params) {
   const ScalarBackend scalar;
   Frame frame;
@@ -72,9 +81,7 @@ int main(int argc, char** argv) {
 
   const auto simd_case = [&](const Scene* scene, Method method, const std::string& isa,
                              int threads) {
-    MarchParams params;
-    params.method = method;
-    if (scene->name.rfind("staircase_", 0) == 0) params.max_distance = 40.0;
+    const MarchParams params = case_params(*scene, method);
     const std::string name = std::string("simd/") + to_string(method) + "/" + scene->name + "/" +
                              isa + "/threads:" + std::to_string(threads);
     BackendOptions options;
@@ -88,12 +95,9 @@ int main(int argc, char** argv) {
     for (const auto& scene : scenes) {
       const bool compared = scene->name == "l_shape" || scene->name == "double_pentagon";
       if (compared || scene->name == "cube" || scene->name == "staircase_32") {
-        MarchParams params;
-        params.method = method;
-        if (scene->name == "staircase_32") params.max_distance = 40.0;
         benchmark::RegisterBenchmark(
             (std::string("scalar/") + to_string(method) + "/" + scene->name).c_str(), scalar_frame,
-            scene.get(), params)
+            scene.get(), case_params(*scene, method))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
       }

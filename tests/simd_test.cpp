@@ -109,9 +109,9 @@ TEST(Simd, EveryInstructionSetAgreesWithScalar) {
 }
 
 // Rays spread over many rooms: staircases whose edges do not fit in a vector, so that a pass
-// over several rooms blends their edges by lane (32 and 128 squares: 128 and 512 edges, more
-// rooms among a packet's rays than a pass takes), or takes one room a pass (130 squares: 520
-// edges, over what the blend's tables hold). Every instruction set gives the scalar frame.
+// over several rooms blends their edges by lane (32 and 128 squares: 128 and 512 edges), or
+// takes one room a pass (130 squares: 520 edges, over what the blend's tables hold). Every
+// instruction set gives the scalar frame.
 TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
   for (int squares : {32, 128, 130}) {
     const Scene scene = reports::staircase_surface(squares);

@@ -107,9 +107,10 @@ constexpr size_t kRefillAt = 4;
 // over more than two), lanes wait until six eighths of them can take a pixel: refilled rays start
 // together in the camera's room, and the packet stays in fewer rooms. Against 4/8 everywhere,
 // 640x360, 2 cores, AVX-512, best of 2 rounds: 32- and 128-square staircases 27.0 -> 24.2 and
-// 27.5 -> 24.6 ms, every gallery scene within 4% either way. Sphere tracing gained 1-4% on the
-// 32-square staircase with fewer lanes busy (0.96 -> 0.82), and over more than one room (not
-// two) lost 5-8% on the 4-square staircase and the double pentagon: it keeps 4/8.
+// 27.5 -> 24.6 ms, every gallery scene within 4% either way. Sphere tracing keeps 4/8: with
+// 6/8 it gained on the 32-square staircase only a few percent (compared across runs) with fewer
+// lanes busy (0.96 -> 0.82), and with the rule at more than one room it lost 5-8% on the
+// 4-square staircase and the double pentagon (one run).
 constexpr size_t kRefillSpread = 6;
 
 // Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
