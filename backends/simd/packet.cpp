@@ -113,38 +113,79 @@ constexpr size_t kRefillAt = 4;
 // 4-square staircase and the double pentagon (one run).
 constexpr size_t kRefillSpread = 6;
 
+// The pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's grid of
+// tiles, in the order a chunk's packets take them: tile by tile, row-major; lane order within a
+// tile; pixels outside the frame skipped. A cursor, not an index: no division per pixel.
+class PixelQueue {
+ public:
+  PixelQueue(const PacketJob& job, int row0, int row1, int col0, int col1, int lanes)
+      : tile_(tile_shape(lanes)),
+        lanes_(lanes),
+        col0_(col0),
+        col1_(col1),
+        row1_(row1),
+        width_(job.width),
+        height_(job.height),
+        row_(row0),
+        col_(col0) {
+    if (col0 >= col1) row_ = row1;
+  }
+  bool empty() const { return row_ >= row1_; }
+  // The next pixel (i, j) in the frame; false when none is left.
+  bool pop(int& i, int& j) {
+    while (!empty()) {  // at most one tile's pixels outside the frame in a row
+      i = col_ * tile_.width + lane_ % tile_.width;
+      j = row_ * tile_.height + lane_ / tile_.width;
+      if (++lane_ == lanes_) {
+        lane_ = 0;
+        if (++col_ == col1_) {
+          col_ = col0_;
+          ++row_;
+        }
+      }
+      if (i < width_ && j < height_) return true;
+    }
+    return false;
+  }
+
+ private:
+  TileShape tile_;
+  int lanes_, col0_, col1_, row1_, width_, height_;
+  int row_, col_, lane_ = 0;  // the next pixel's tile row, tile column and lane
+};
+
 // Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
 // grid of tiles and writes them. The lanes of one packet take the chunk's pixels tile by tile,
 // and a lane whose ray has ended takes a next pixel soon (kRefillAt), so that a few long rays do
 // not hold up the rest of their tile (lanes stay busy until the chunk's pixels run out).
 void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
-  const TileShape tile = tile_shape(PacketLanes());
   const Marcher marcher(*job.tables, job.edge_extra, nullptr, 0);
   const DI di;
   constexpr size_t kMax = hn::MaxLanes(DI());
   const size_t n = hn::Lanes(D());
-  std::array<float, kMax> red{}, green{}, blue{}, t{};
-  std::array<int32_t, kMax> steps{}, crossings{}, hit{}, fresh{};
-  std::array<int32_t, kMax> pixel_i{}, pixel_j{};
-  pixel_i.fill(-1);  // -1: the lane holds no pixel
+  std::array<float, kMax> red{}, green{}, blue{}, t{}, steps{}, crossings{}, hit{};
+  std::array<int32_t, kMax> fresh{};
+  std::array<int32_t, kMax> pixel_i{}, pixel_j{};  // -1: the lane holds no pixel
+  std::array<int64_t, kMax> pixel{};               // (i, j)'s index in the frame's channels
+  pixel_i.fill(-1);
+  pixel.fill(-1);
   const V from_x = Splat(job.from.x), from_y = Splat(job.from.y), from_z = Splat(job.from.z);
+  Frame& frame = *job.frame;
 
-  // The chunk's pixels in queue order: tile by tile, row-major; lane order within a tile.
-  const int tiles_across = col1 - col0;
-  const int64_t queue = int64_t{row1 - row0} * tiles_across * tile.width * tile.height;
-  int64_t next = 0;
+  PixelQueue queue(job, row0, row1, col0, col1, static_cast<int>(n));
+  const int64_t pixels = int64_t{row1 - row0} * (col1 - col0) * static_cast<int64_t>(n);
   Packet r;
   Relaxation x;
   Segment seg;
   Marcher::clear(r, x, seg);
   // Every iteration steps at least one ray, and a ray takes at most max_steps steps.
-  const int64_t bound = queue * (int64_t{job.tables->params.max_steps} + 1) + 1;
+  const int64_t bound = pixels * (int64_t{job.tables->params.max_steps} + 1) + 1;
   M occupied = None();  // lanes holding a pixel
   const bool analytic = job.tables->params.method == kMethodAnalytic;
   bool spread = false;  // the analytic method's rays over several rooms (kRefillSpread)
   for (int64_t iteration = 0; iteration < bound; ++iteration) {
     // Lanes are refilled once enough of them wait, or when none is left marching.
-    const M waiting = next < queue ? r.done : hn::And(r.done, occupied);
+    const M waiting = !queue.empty() ? r.done : hn::And(r.done, occupied);
     const size_t count = hn::CountTrue(D(), waiting);
     bool refill = false;
     if (count > 0 &&
@@ -156,9 +197,9 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       hn::StoreU(cg, D(), green.data());
       hn::StoreU(cb, D(), blue.data());
       hn::StoreU(r.t, D(), t.data());
-      hn::StoreU(r.steps, di, steps.data());
-      hn::StoreU(r.crossings, di, crossings.data());
-      hn::StoreU(r.hit, di, hit.data());
+      hn::StoreU(hn::ConvertTo(D(), r.steps), D(), steps.data());
+      hn::StoreU(hn::ConvertTo(D(), r.crossings), D(), crossings.data());
+      hn::StoreU(hn::ConvertTo(D(), r.hit), D(), hit.data());
       fresh.fill(0);
       uint8_t bits[8] = {};
       hn::StoreMaskBits(D(), waiting, bits);
@@ -166,23 +207,22 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       for (size_t b = 0; b < 8; ++b) lanes_waiting |= uint64_t{bits[b]} << (8 * b);
       for (; lanes_waiting != 0; lanes_waiting &= lanes_waiting - 1) {
         const size_t l = static_cast<size_t>(hwy::Num0BitsBelowLS1Bit_Nonzero64(lanes_waiting));
-        if (pixel_i[l] >= 0)
-          job.frame->set(pixel_i[l], pixel_j[l], Vec3(red[l], green[l], blue[l]), steps[l],
-                         crossings[l], hit[l], t[l]);
-        pixel_i[l] = -1;
-        while (next < queue && pixel_i[l] < 0) {
-          const int64_t tile_index = next / static_cast<int64_t>(n);
-          const int lane = static_cast<int>(next % static_cast<int64_t>(n));
-          ++next;
-          const int i =
-              (col0 + static_cast<int>(tile_index % tiles_across)) * tile.width + lane % tile.width;
-          const int j = (row0 + static_cast<int>(tile_index / tiles_across)) * tile.height +
-                        lane / tile.width;
-          if (i >= job.width || j >= job.height) continue;
-          pixel_i[l] = i;
-          pixel_j[l] = j;
+        if (pixel[l] >= 0) {
+          const auto px = static_cast<size_t>(pixel[l]);
+          frame.rgb[3 * px] = red[l];
+          frame.rgb[3 * px + 1] = green[l];
+          frame.rgb[3 * px + 2] = blue[l];
+          frame.steps[px] = steps[l];
+          frame.crossings[px] = crossings[l];
+          frame.hit[px] = hit[l];
+          frame.t[px] = t[l];
+        }
+        if (queue.pop(pixel_i[l], pixel_j[l])) {
+          pixel[l] = static_cast<int64_t>(frame.pixel(pixel_i[l], pixel_j[l]));
           fresh[l] = -1;
           refill = true;
+        } else {
+          pixel[l] = pixel_i[l] = -1;
         }
       }
       occupied = hn::RebindMask(D(), hn::Gt(hn::LoadU(di, pixel_i.data()), SplatI(-1)));
