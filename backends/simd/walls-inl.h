@@ -1,7 +1,8 @@
 // The walls of a pass's rooms for packets of rays: distances to them, where rays leave by them,
 // which are opaque, and what a gluing does to the rays that cross one (march.glsl's "Walls").
 // A pass's table reads are one broadcast record per room, or, where a pass spans several rooms,
-// a lookup of each lane's edge in vectors holding the scene's edges.
+// a lookup of each lane's edge in one or two vectors holding the scene's edges (or, for more
+// edges, a broadcast per room blended by lane).
 
 // Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
 // re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
@@ -34,13 +35,14 @@ class Walls {
         params_(tables.params),
         features_(tables.features) {
     // Passes over several rooms read each lane's edge from the scene's edge numbers: by a lookup
-    // in one vector when the edges fit in one, else by a broadcast per room blended by lane
-    // (cheaper than a gather), for scenes of up to kMostEdges edges.
-    const size_t edges = tables.edges.size();
-    mode_ = edges <= hn::Lanes(D()) ? kTable : edges <= kMostEdges ? kBlend : kSingle;
+    // in up to kMostVectors vectors when the edges fit in them, else by a broadcast per room
+    // blended by lane (cheaper than a gather), for scenes of up to kMostEdges edges.
+    const size_t edges = tables.edges.size(), lanes = hn::Lanes(D());
+    vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
+    mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
     if (mode_ == kSingle) return;
-    // Zero up to a whole vector, for the lookup's load.
-    const size_t filled = std::max(edges, hn::Lanes(D()));
+    // Zero up to whole vectors, for the lookup's loads.
+    const size_t filled = std::max(edges, vectors_ * lanes);
     for (size_t f = 0; f < kFields; ++f) {
       std::fill_n(lookup_[f].begin(), filled, 0.0f);
       for (size_t e = 0; e < edges; ++e)
@@ -48,7 +50,7 @@ class Walls {
     }
     if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
-    std::fill_n(first_edge_.begin(), std::max(tables.polygons.size(), hn::Lanes(D())), 0);
+    std::fill_n(first_edge_.begin(), filled, 0);
     for (size_t p = 0; p < tables.polygons.size(); ++p) first_edge_[p] = tables.polygons[p].x;
     for (auto& g : glue_) std::fill_n(g.begin(), filled, 0.0f);
     std::fill_n(to_polygon_.begin(), filled, 0);
@@ -78,7 +80,7 @@ class Walls {
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
   bool merge() const { return mode_ != kSingle; }
   // Whether crossings look each lane's gluing up in vectors (cross_glued). Where the edges do
-  // not fit in one, a crossing takes a round per edge crossed: a gather of each lane's gluing
+  // not fit in two, a crossing takes a round per edge crossed: a gather of each lane's gluing
   // made the cube's and the staircases' analytic frames 1.4-1.5x slower (measured).
   bool glue_by_lane() const { return mode_ == kTable; }
 
@@ -263,14 +265,27 @@ class Walls {
   template <typename T>
   using Table = std::array<T, kMostEdges>;
 
-  // Entry `index` of `table` for each lane, the table held in one vector (kTable).
+  // Entry `index` of `table` for each lane, the table held in one vector or two (kTable): in
+  // two, a lookup in each and the lane's own kept.
   template <class DT, typename T>
   FLATMARCH_PACKET_INLINE hn::Vec<DT> lookup(DT d, const Table<T>& table, VI index) const {
-    return hn::TableLookupLanes(hn::LoadU(d, table.data()), hn::IndicesFromVec(d, index));
+    if (vectors_ == 1)
+      return hn::TableLookupLanes(hn::LoadU(d, table.data()), hn::IndicesFromVec(d, index));
+    const int lanes = static_cast<int>(hn::Lanes(d));
+    const auto low = hn::IndicesFromVec(d, hn::And(index, SplatI(lanes - 1)));
+    const auto upper = hn::RebindMask(d, hn::Gt(index, SplatI(lanes - 1)));
+    return hn::IfThenElse(upper, hn::TableLookupLanes(hn::LoadU(d, table.data() + lanes), low),
+                          hn::TableLookupLanes(hn::LoadU(d, table.data()), low));
   }
 
   // How a pass over several rooms reads its lanes' edges.
   enum Mode { kSingle, kTable, kBlend } mode_ = kSingle;
+  // kTable's vectors a table, one or two. In two: 16 lanes, the cube's 24 edges, frames
+  // 1.2-1.25x faster than with broadcasts blended by room (kBlend); 8 lanes, the double
+  // pentagon's 10 edges, 1.04-1.1x. In three, 4 lanes, the double pentagon was 3-7% slower than
+  // kBlend (one run each, best of 2 rounds).
+  static constexpr size_t kMostVectors = 2;
+  size_t vectors_ = 1;
   std::array<Table<float>, kFields> lookup_;  // [field][edge]
   // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
   // (3); and the destination polygon.
