@@ -123,9 +123,9 @@ struct Segment {
 
 // The rooms of one pass: the polygons its rays are in (at most kRoomsPerPass) and the lanes in
 // each. A table read gives every lane its own room's record: in one room a broadcast; in several
-// a lookup of each lane's edge in vectors holding the scene's edges (Walls::lookup_), or, where
-// the edges do not fit in a vector, each room's record broadcast and blended by lane (scenes of
-// over Walls::kMostEdges edges take one room a pass). Coherent rays are mostly in one room; rays
+// a lookup of each lane's edge in one or two vectors holding the scene's edges (Walls::lookup_),
+// or, where the edges do not fit in two, each room's record broadcast and blended by lane (scenes
+// of over Walls::kMostEdges edges take one room a pass). Coherent rays are mostly in one room; rays
 // split between a few (the double pentagon's two, at every crossing) or spread over many (the
 // cube, a staircase) still take one pass a step, not one per room. 8 rooms a pass against 4:
 // frames level, lanes busy 0.84 -> 0.90 on the cube and 0.83 -> 0.96 on 32- and 128-square
