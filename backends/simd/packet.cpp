@@ -112,17 +112,19 @@ constexpr size_t kRefillAt = 4;
 // lanes busy (0.96 -> 0.82), and with the rule at more than one room it lost 5-8% on the
 // 4-square staircase and the double pentagon (one run).
 constexpr size_t kRefillSpread = 6;
-// In a scene of one or two rooms without mirrors, lanes that have waited this many steps are
-// refilled however few they are: there rays refilled apart stay in few rooms, and long rays
-// (prisms: hundreds of steps) no longer leave lanes idle for long. Sphere and relaxed tracing in
-// two rooms wait longer (kRefillPatienceTwoRooms): at 16 steps they were 3-8% slower on the
-// double pentagon, its singularities and the pillowcase. 640x360, 2 cores, AVX-512, best of 2
-// interleaved rounds against no patience: prisms 0.89-0.96x the time, lanes busy 0.78-0.86 ->
-// 0.86-0.99; the two-room scenes' analytic method 0.90-0.97x; the rest 0.96-1.03x. In scenes of
-// more rooms it made sphere tracing on the cube 1.2x and on a 32-square staircase 1.8x slower
-// (rays started apart spread over more rooms a pass, and a pass over one room is the cheapest),
-// and in the mirror rooms 1.10-1.15x slower (rays started apart meet different mirrors at a step,
-// and a reflection takes a round per mirror).
+// In a scene of one or two rooms without mirrors (for the analytic method, one room with or
+// without), lanes that have waited this many steps are refilled however few they are: there rays
+// refilled apart stay in few rooms, and long rays (prisms: hundreds of steps) no longer leave lanes
+// idle for long. Sphere and relaxed tracing in two rooms wait longer (kRefillPatienceTwoRooms): at
+// 16 steps they were 3-8% slower on the double pentagon, its singularities and the pillowcase.
+// 640x360, 2 cores, AVX-512, best of 2 interleaved rounds against no patience: prisms 0.89-0.96x
+// the time, lanes busy 0.78-0.86 -> 0.86-0.99; the two-room scenes' analytic method 0.90-0.97x; the
+// rest 0.96-1.03x. In scenes of more rooms it made sphere tracing on the cube 1.2x and on a
+// 32-square staircase 1.8x slower (rays started apart spread over more rooms a pass, and a pass
+// over one room is the cheapest), and sphere tracing in the mirror rooms 1.10-1.15x slower (rays
+// started apart meet different mirrors at a step, and a reflection takes a round per mirror); the
+// analytic method there is level with it (0.99-1.02x) and keeps a few more lanes busy (the 30-60-90
+// triangle 0.84 -> 0.85).
 constexpr int kRefillPatience = 16;
 constexpr int kRefillPatienceTwoRooms = 48;
 
@@ -199,7 +201,7 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   const size_t rooms_in_scene = job.tables->polygons.size();
   const bool mirrors = (job.tables->features & kFeatureMirrors) != 0u;
   int patience = 0;  // none: refill by kRefillAt and kRefillSpread only
-  if (!mirrors && rooms_in_scene == 1) patience = kRefillPatience;
+  if ((analytic || !mirrors) && rooms_in_scene == 1) patience = kRefillPatience;
   if (!mirrors && rooms_in_scene == 2)
     patience = analytic ? kRefillPatience : kRefillPatienceTwoRooms;
   int waited = 0;  // steps since the last refill, counted where patience applies
