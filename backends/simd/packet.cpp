@@ -113,7 +113,8 @@ constexpr size_t kRefillAt = 4;
 // 4-square staircase and the double pentagon (one run).
 constexpr size_t kRefillSpread = 6;
 // In a scene of one or two rooms without mirrors (for the analytic method, one room with or
-// without), lanes that have waited this many steps are refilled however few they are: there rays
+// without), once this many steps have passed since the last refill, the lanes waiting are
+// refilled however few they are: there rays
 // refilled apart stay in few rooms, and long rays (prisms: hundreds of steps) no longer leave lanes
 // idle for long. Sphere and relaxed tracing in two rooms wait longer (kRefillPatienceTwoRooms): at
 // 16 steps they were 3-8% slower on the double pentagon, its singularities and the pillowcase.
