@@ -58,8 +58,10 @@ def main():
         speedup = top["rays_per_s"] / scalar
         scaling = top["rays_per_s"] / one[isa] if isa in one else float("nan")
         ones = " ".join(f"{k}:{v / 1e6:.2f}M" for k, v in one.items())
+        # "-" where the run has no one-thread case of this instruction set to scale from.
+        scaled = f"{scaling:>7.2f}x" if isa in one else f"{'-':>8}"
         print(f"{scene:<16} {method:<9} {scalar / 1e6:>9.3f}M {ones:>28} "
-              f"{top['rays_per_s'] / 1e6:>9.2f}M {speedup:>7.1f}x {scaling:>7.2f}x "
+              f"{top['rays_per_s'] / 1e6:>9.2f}M {speedup:>7.1f}x {scaled} "
               f"{top['lane_utilisation']:>10.2f}")
         failed |= speedup < args.min_speedup or scaling < args.min_scaling
     return 1 if failed else 0
