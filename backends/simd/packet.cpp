@@ -114,18 +114,18 @@ constexpr size_t kRefillAt = 4;
 constexpr size_t kRefillSpread = 6;
 // In a scene of one or two rooms without mirrors (for the analytic method, one room with or
 // without), once this many steps have passed since the last refill, the lanes waiting are
-// refilled however few they are: there rays
-// refilled apart stay in few rooms, and long rays (prisms: hundreds of steps) no longer leave lanes
-// idle for long. Sphere and relaxed tracing in two rooms wait longer (kRefillPatienceTwoRooms): at
-// 16 steps they were 3-8% slower on the double pentagon, its singularities and the pillowcase.
-// 640x360, 2 cores, AVX-512, best of 2 interleaved rounds against no patience: prisms 0.89-0.96x
-// the time, lanes busy 0.78-0.86 -> 0.86-0.99; the two-room scenes' analytic method 0.90-0.97x; the
-// rest 0.96-1.03x. In scenes of more rooms it made sphere tracing on the cube 1.2x and on a
-// 32-square staircase 1.8x slower (rays started apart spread over more rooms a pass, and a pass
-// over one room is the cheapest), and sphere tracing in the mirror rooms 1.10-1.15x slower (rays
-// started apart meet different mirrors at a step, and a reflection takes a round per mirror); the
-// analytic method there is level with it (0.99-1.02x) and keeps a few more lanes busy (the 30-60-90
-// triangle 0.84 -> 0.85).
+// refilled however few they are: there rays refilled apart stay in few rooms, and long rays
+// (prisms: hundreds of steps) no longer leave lanes idle for long. Sphere and relaxed tracing in
+// two rooms wait longer (kRefillPatienceTwoRooms): at 16 steps they were 3-8% slower on the
+// double pentagon, its singularities and the pillowcase. 640x360, 2 cores, AVX-512, best of 2
+// interleaved rounds against no patience: prisms 0.89-0.96x the time, lanes busy 0.78-0.86 ->
+// 0.86-0.99; the two-room scenes' analytic method 0.90-0.97x; the rest 0.96-1.03x. In scenes of
+// more rooms it made sphere tracing on the cube 1.2x and on a 32-square staircase 1.8x slower
+// (rays started apart spread over more rooms a pass, and a pass over one room is the cheapest),
+// and sphere tracing in the mirror rooms 1.10-1.15x slower (rays started apart meet different
+// mirrors at a step, and a reflection takes a round per mirror); the analytic method there is
+// level with it (0.99-1.02x) and keeps a few more lanes busy (the 30-60-90 triangle 0.84 ->
+// 0.85).
 constexpr int kRefillPatience = 16;
 constexpr int kRefillPatienceTwoRooms = 48;
 
