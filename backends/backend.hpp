@@ -112,12 +112,20 @@ struct Frame {
   }
   // Writes pixel (i, j): its linear colour and how its ray ended.
   void set(int i, int j, Vec3 color, int ray_steps, int ray_crossings, int ray_hit, double ray_t) {
-    const size_t px = pixel(i, j);
-    for (int n = 0; n < 3; ++n) rgb[3 * px + static_cast<size_t>(n)] = static_cast<float>(color[n]);
-    steps[px] = static_cast<float>(ray_steps);
-    crossings[px] = static_cast<float>(ray_crossings);
-    hit[px] = static_cast<float>(ray_hit);
-    t[px] = static_cast<float>(ray_t);
+    set(pixel(i, j), static_cast<float>(color.x), static_cast<float>(color.y),
+        static_cast<float>(color.z), static_cast<float>(ray_steps),
+        static_cast<float>(ray_crossings), static_cast<float>(ray_hit), static_cast<float>(ray_t));
+  }
+  // The same for pixel index `px` (pixel()), with every value already a channel's float.
+  void set(size_t px, float red, float green, float blue, float ray_steps, float ray_crossings,
+           float ray_hit, float ray_t) {
+    rgb[3 * px] = red;
+    rgb[3 * px + 1] = green;
+    rgb[3 * px + 2] = blue;
+    steps[px] = ray_steps;
+    crossings[px] = ray_crossings;
+    hit[px] = ray_hit;
+    t[px] = ray_t;
   }
 };
 

@@ -119,7 +119,7 @@ constexpr size_t kRefillSpread = 6;
 // two rooms wait longer (kRefillPatienceTwoRooms): at 16 steps they were 3-8% slower on the
 // double pentagon, its singularities and the pillowcase. 640x360, 2 cores, AVX-512, best of 2
 // interleaved rounds against no patience: prisms 0.89-0.96x the time, lanes busy 0.78-0.86 ->
-// 0.86-0.99; the two-room scenes' analytic method 0.90-0.97x; the rest 0.96-1.03x. In scenes of
+// 0.86-0.99; the two-room scenes' analytic method 0.90-0.97x; the rest 0.96-1.04x. In scenes of
 // more rooms it made sphere tracing on the cube 1.2x and on a 32-square staircase 1.8x slower
 // (rays started apart spread over more rooms a pass, and a pass over one room is the cheapest),
 // and sphere tracing in the mirror rooms 1.10-1.15x slower (rays started apart meet different
@@ -149,7 +149,7 @@ class PixelQueue {
   bool empty() const { return row_ >= row1_; }
   // The next pixel (i, j) in the frame; false when none is left.
   bool pop(int& i, int& j) {
-    while (!empty()) {  // at most one tile's pixels outside the frame in a row
+    while (!empty()) {  // bounded: every turn moves the cursor on
       i = col_ * tile_.width + lane_ % tile_.width;
       j = row_ * tile_.height + lane_ / tile_.width;
       if (++lane_ == lanes_) {
@@ -181,10 +181,8 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   const size_t n = hn::Lanes(D());
   std::array<float, kMax> red{}, green{}, blue{}, t{}, steps{}, crossings{}, hit{};
   std::array<int32_t, kMax> fresh{};
-  std::array<int32_t, kMax> pixel_i{}, pixel_j{};  // -1: the lane holds no pixel
-  std::array<int64_t, kMax> pixel{};               // (i, j)'s index in the frame's channels
-  pixel_i.fill(-1);
-  pixel.fill(-1);
+  std::array<int32_t, kMax> pixel_i{}, pixel_j{};
+  pixel_i.fill(-1);  // -1: the lane holds no pixel
   const V from_x = Splat(job.from.x), from_y = Splat(job.from.y), from_z = Splat(job.from.z);
   Frame& frame = *job.frame;
 
@@ -231,22 +229,14 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       for (size_t b = 0; b < 8; ++b) lanes_waiting |= uint64_t{bits[b]} << (8 * b);
       for (; lanes_waiting != 0; lanes_waiting &= lanes_waiting - 1) {
         const size_t l = static_cast<size_t>(hwy::Num0BitsBelowLS1Bit_Nonzero64(lanes_waiting));
-        if (pixel[l] >= 0) {
-          const auto px = static_cast<size_t>(pixel[l]);
-          frame.rgb[3 * px] = red[l];
-          frame.rgb[3 * px + 1] = green[l];
-          frame.rgb[3 * px + 2] = blue[l];
-          frame.steps[px] = steps[l];
-          frame.crossings[px] = crossings[l];
-          frame.hit[px] = hit[l];
-          frame.t[px] = t[l];
-        }
+        if (pixel_i[l] >= 0)
+          frame.set(frame.pixel(pixel_i[l], pixel_j[l]), red[l], green[l], blue[l], steps[l],
+                    crossings[l], hit[l], t[l]);
         if (queue.pop(pixel_i[l], pixel_j[l])) {
-          pixel[l] = static_cast<int64_t>(frame.pixel(pixel_i[l], pixel_j[l]));
           fresh[l] = -1;
           refill = true;
         } else {
-          pixel[l] = pixel_i[l] = -1;
+          pixel_i[l] = -1;
         }
       }
       occupied = hn::RebindMask(D(), hn::Gt(hn::LoadU(di, pixel_i.data()), SplatI(-1)));
