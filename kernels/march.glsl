@@ -78,21 +78,13 @@ void finish(INOUT(Ray) r, int hit, int event, int edge, real s) {
 
 // ---- Walls -----------------------------------------------------------------------------------
 
-// Whether the horizontal ray from p in +x crosses the edge from a to a + ab (crossing number).
-bool crosses(vec2 a, vec2 ab, vec2 p) {
-  vec2 ap = p - a;
-  bool over_a = p.y >= a.y;
-  bool under_b = p.y < a.y + ab.y;
-  bool left = ab.x * ap.y > ab.y * ap.x;
-  return (over_a && under_b && left) || (!over_a && !under_b && !left);
-}
-
 bool inside_polygon(int polygon, vec2 p) {
   ivec4 poly = polygons[room(polygon)];
   bool inside = false;
   for (int k = poly.x; k < poly.x + poly.y; ++k) {
     vec4 s = edges[k].segment;
-    if (crosses(vec2(s.x, s.y), vec2(s.z - s.x, s.w - s.y), p)) inside = !inside;
+    vec2 a = vec2(s.x, s.y);
+    if (crosses(p.y, s.y, s.y + (s.w - s.y), p - a, vec2(s.z, s.w) - a)) inside = !inside;
   }
   return inside;
 }
@@ -115,9 +107,7 @@ WallDistance wall_distance(int polygon, vec2 p) {
     vec4 s = edges[poly.x + k].segment;
     vec2 a = vec2(s.x, s.y);
     vec2 ab = vec2(s.z, s.w) - a;
-    real h = clamp(dot(p - a, ab) * edges[poly.x + k].line.w, real(0), real(1));
-    vec2 q = p - a - h * ab;
-    real d2 = dot(q, q);
+    real d2 = segment_distance2(p - a, ab, edges[poly.x + k].line.w);
     if (d2 < best) {
       second = best;
       best = d2;
@@ -125,7 +115,7 @@ WallDistance wall_distance(int polygon, vec2 p) {
     } else if (d2 < second) {
       second = d2;
     }
-    if (crosses(a, ab, p)) inside = !inside;
+    if (crosses(p.y, a.y, a.y + ab.y, p - a, ab)) inside = !inside;
   }
   WallDistance w;
   w.d = inside ? sqrt(best) : -sqrt(best);
@@ -155,28 +145,21 @@ Exit exit_edge(int polygon, vec2 o, vec2 dh) {
     vec2 n = vec2(line.x, line.y);
     real dn = dot(dh, n);
     if (dn > real(0)) {  // else the ray cannot leave through this edge
-      real s = (line.z - dot(o, n)) / dn;
+      real s = line_distance(o, n, line.z, dn);
       if (s >= -params.vertex_tolerance && s < x.s) {
         vec4 seg = edges[poly.x + k].segment;
         vec2 a = vec2(seg.x, seg.y);
-        real u = dot(o + s * dh - a, vec2(seg.z, seg.w) - a) * line.w;  // 0 at a, 1 at b
-        real tolerance = params.vertex_tolerance * sqrt(line.w);        // in units of u
-        if (u >= -tolerance && u <= real(1) + tolerance) {
+        real u = edge_parameter(o + s * dh, a, vec2(seg.z, seg.w) - a, line.w);
+        real tolerance = params.vertex_tolerance * sqrt(line.w);  // in units of u
+        if (on_edge(u, tolerance)) {
           x.s = max(s, real(0));
           x.edge = k;
-          x.corner = u <= tolerance || u >= real(1) - tolerance;
+          x.corner = near_end(u, tolerance);
         }
       }
     }
   }
   return x;
-}
-
-// Distance along the ray to where it leaves the band [0, top].
-real band_exit(vec3 o, vec3 d) {
-  if (d.z > real(0)) return (params.top - o.z) / d.z;
-  if (d.z < real(0)) return -o.z / d.z;
-  return real(kFar);
 }
 
 // A ray at edge k of its polygon goes through it into the glued room, or is reflected by a
@@ -254,18 +237,11 @@ SolidDistance nearest_solid(int polygon, vec3 p) {
 real solid_entry(int polygon, vec3 o, vec3 d) {
   ivec4 poly = polygons[room(polygon)];
   real first = real(kFar);
-  bool inside = false;  // already inside one
   for (int k = poly.z; k < poly.z + poly.w; ++k) {
     vec4 c = objects[k].center;
-    vec3 oc = o - vec3(c);
-    real radius = c.w + params.eps;
-    real b = dot(oc, d);
-    real cc = dot(oc, oc) - radius * radius;
-    inside = inside || cc <= real(0);
-    real disc = b * b - cc;
-    if (b < real(0) && disc >= real(0)) first = min(first, -b - sqrt(disc));
+    first = min(first, sphere_entry(o - vec3(c), d, c.w + params.eps));
   }
-  return inside ? real(0) : first;
+  return first;
 }
 
 // The unit normal of solid k of the object table at p.
@@ -348,7 +324,7 @@ void sphere_step(INOUT(Ray) r, INOUT(Relaxation) x) {
     return;
   }
   real safe = abs(radius);
-  real band = band_exit(r.o, r.d);
+  real band = band_exit(params.top, r.o.z, r.d.z);
   real remaining = params.max_distance - r.t;
   if (remaining <= min(safe, band)) {
     finish(r, kHitMaxDistance, kEventMaxDistance, -1, remaining);
@@ -388,14 +364,14 @@ void find_segment(INOUT(Ray) r, INOUT(Segment) seg) {
 // room, of the band or of max_distance).
 bool near_solid(Ray r, Segment seg) {
   return has(kFeatureObjects) && seg.known &&
-         seg.solids < min(min(seg.exit.s, band_exit(r.o, r.d)),
+         seg.solids < min(min(seg.exit.s, band_exit(params.top, r.o.z, r.d.z)),
                           params.max_distance - r.t);
 }
 
 // The rest of the room segment: the ray leaves the band, ends, or crosses the exit edge.
 void segment_step(INOUT(Ray) r, INOUT(Segment) seg) {
   real remaining = params.max_distance - r.t;
-  real band = band_exit(r.o, r.d);
+  real band = band_exit(params.top, r.o.z, r.d.z);
   if (remaining < min(seg.exit.s, band)) {
     finish(r, kHitMaxDistance, kEventMaxDistance, -1, remaining);
   } else if (band <= seg.exit.s) {
@@ -423,7 +399,7 @@ void analytic_step(INOUT(Ray) r, INOUT(Segment) seg) {
     if (solid.d < params.eps) {
       hit_solid(r, solid.object);
       whole = false;
-    } else if (solid.d < min(min(seg.exit.s, band_exit(r.o, r.d)),
+    } else if (solid.d < min(min(seg.exit.s, band_exit(params.top, r.o.z, r.d.z)),
                              params.max_distance - r.t)) {
       move_in_segment(r, seg, solid.d);
       whole = false;
@@ -438,9 +414,7 @@ void analytic_step(INOUT(Ray) r, INOUT(Segment) seg) {
 // the first polygon whose footprint it crosses at the band's top (or bottom).
 void enter_band(INOUT(Ray) r) {
   bool above = r.o.z > params.height;
-  bool toward = above ? r.d.z < real(0) : r.d.z > real(0);
-  real s = toward ? ((above ? params.height : real(0)) - r.o.z) / r.d.z : params.max_distance;
-  if (s > params.max_distance) s = params.max_distance;  // the band is out of reach
+  real s = band_entry(params.height, r.o.z, r.d.z, params.max_distance);
   vec3 q = r.o + s * r.d;
   int entered = -1;  // the first polygon whose footprint q is in
   if (s < params.max_distance) {
@@ -547,11 +521,10 @@ vec3 shade(Ray r) {
   } else if (r.hit == kHitWall) {
     surface = vec3(real(kWallGrey));
   } else if (r.hit == kHitFloor) {
-    real check = floor(r.o.x / real(kFloorCheck)) + floor(r.o.y / real(kFloorCheck));
-    surface = vec3(real(mod(check, real(2)) >= real(1) ? kFloorDarkGrey : kWallGrey));
+    surface = vec3(floor_tone(vec2(r.o)));
   } else if (r.hit == kHitMaxSteps || r.hit == kHitVertex) {
     surface = vec3(real(0));  // undecided rays show as black
   }
   real transmittance = pow(real(1) - params.wall_tint, real(r.crossings));
-  return transmittance * surface + (real(1) - transmittance) * vec3(params.fog);
+  return through_walls(surface, transmittance, vec3(params.fog));
 }

@@ -12,12 +12,12 @@
 // division by zero or a square root of a negative number is, its lane discarded). A choice on
 // a value that is the same for every lane of a packet (a solid's kind) may be an `if`.
 //
-// Not here: the maths of a room's step (distance to the walls and the crossing test, the exit
-// edge's parameters, the band exit, a ray's entry into a solid's bounding sphere). Written over these packet types they made the SIMD backend
-// 15-37% slower (the L-shape's analytic frame 11.2 -> 15.3 ms, 2 cores, AVX2; why was not found),
-// so march.glsl and backends/simd/walls-inl.h each spell them out, and tests/simd_test.cpp holds
-// them to the same bits. KINLINE marks each function to be inlined where the compiler would not on its own (on packets: each is
-// a handful of vector operations, and a call would pass its vectors through memory).
+// The room step's maths is here too (an edge's distance and crossing test, the exit parameters,
+// the band exit, a solid's distance and bounding sphere): march.glsl and the SIMD backend read
+// the tables their own way (one room per ray; broadcasts or lookups per packet) and hand the
+// numbers to these. KINLINE marks each function to be inlined where the compiler would not on
+// its own (on packets: each is a handful of vector operations, and a call would pass its vectors
+// through memory).
 
 // The camera's unit ray through the image point (x, y), in pixels from the top left corner of an
 // image `size` pixels wide and high (DESIGN.md section 2): forward, right and up are the camera's
@@ -84,4 +84,86 @@ KINLINE vec3 solid_gradient(int solid, vec3 c, vec4 shape, vec3 p, real h) {
 // A solid's own colour when it has one (w > 0), else its normal's (DESIGN.md section 1).
 KINLINE vec3 solid_surface(vec4 color, vec3 normal) {
   return select(color.w > real(0), vec3(color), real(0.5) + real(0.5) * normal);
+}
+
+// ---- A room's step ---------------------------------------------------------------------------
+
+// The square of the distance from a point to the edge from a to a + ab: ap is the point less a,
+// w is 1 / |ab|^2 (the edge table's line.w).
+KINLINE real segment_distance2(vec2 ap, vec2 ab, real w) {
+  real h = clamp(dot(ap, ab) * w, real(0), real(1));
+  vec2 q = ap - h * ab;
+  return dot(q, q);
+}
+
+// Whether the horizontal ray from a point at height py in +x crosses the edge from a to a + ab,
+// whose ends are at heights ay and by (= ay + ab.y), ap being the point less a: the crossing
+// number's test, which counts the edge's lower end and not its upper one.
+KINLINE lane_bool crosses(real py, real ay, real by, vec2 ap, vec2 ab) {
+  lane_bool over_a = py >= ay;
+  lane_bool under_b = py < by;
+  lane_bool left = ab.x * ap.y > ab.y * ap.x;
+  return (over_a && under_b && left) || !(over_a || under_b || left);
+}
+
+// How far a ray from o along dh goes to meet a line (unit normal n, offset c) that it moves
+// towards, dn = dot(dh, n) > 0 (dh's length makes this a 3D distance).
+KINLINE real line_distance(vec2 o, vec2 n, real c, real dn) {
+  return (c - dot(o, n)) / dn;
+}
+
+// Where the point p lies along the edge from a to a + ab: 0 at a, 1 at the other end (w as in
+// segment_distance2).
+KINLINE real edge_parameter(vec2 p, vec2 a, vec2 ab, real w) {
+  return dot(p - a, ab) * w;
+}
+
+// Whether the parameter u is on its edge, to within `tolerance` of its ends.
+KINLINE lane_bool on_edge(real u, real tolerance) {
+  return u >= -tolerance && u <= real(1) + tolerance;
+}
+
+// Whether the parameter u is within `tolerance` of an end of its edge: the ray leaves by a vertex.
+KINLINE lane_bool near_end(real u, real tolerance) {
+  return u <= tolerance || u >= real(1) - tolerance;
+}
+
+// How far a ray at height z, rising dz per unit of its length, goes to leave the band [0, top];
+// kFar if it runs level.
+KINLINE real band_exit(real top, real z, real dz) {
+  real s = select(dz > real(0), top - z, -z) / dz;
+  return select(dz > real(0), s, select(dz < real(0), s, real(kFar)));
+}
+
+// How far a ray at height z, rising dz per unit of its length, from outside the band [0, height]
+// goes to reach it; max_distance if it moves away from it or cannot reach it by then.
+KINLINE real band_entry(real height, real z, real dz, real max_distance) {
+  lane_bool above = z > height;
+  lane_bool toward = select(above, dz < real(0), dz > real(0));
+  real s = select(toward, (select(above, height, real(0)) - z) / dz, max_distance);
+  return select(s > max_distance, max_distance, s);
+}
+
+// How far a ray from o along the unit d goes to come within `radius` of a point c (oc = o - c):
+// 0 if it is already, kFar if it never does ahead of o.
+KINLINE real sphere_entry(vec3 oc, vec3 d, real radius) {
+  real b = dot(oc, d);
+  real cc = dot(oc, oc) - radius * radius;
+  real disc = b * b - cc;
+  // (The root of a negative disc is never kept, but one taken in C++ calls the library to set
+  // errno: 20% of the scalar analytic frame.)
+  real ahead = select(b < real(0) && disc >= real(0), -b - sqrt(max(disc, real(0))), real(kFar));
+  return select(cc <= real(0), real(0), ahead);
+}
+
+// A surface's colour seen through walls that let `transmittance` of its light through; fog
+// makes up the rest.
+KINLINE vec3 through_walls(vec3 surface, real transmittance, vec3 fog) {
+  return transmittance * surface + (real(1) - transmittance) * fog;
+}
+
+// The floor's colour at p: grey checks kFloorCheck wide (DESIGN.md section 1).
+KINLINE real floor_tone(vec2 p) {
+  real check = floor(p.x / real(kFloorCheck)) + floor(p.y / real(kFloorCheck));
+  return select(mod(check, real(2)) >= real(1), real(kFloorDarkGrey), real(kWallGrey));
 }

@@ -7,6 +7,12 @@
 // A condition per ray, and the choice it makes (kernels/maths.glsl).
 #define lane_bool bool
 #define KINLINE
+bool select(bool c, bool a, bool b) {
+  return c ? a : b;
+}
+real select(bool c, real a, real b) {
+  return c ? a : b;
+}
 vec3 select(bool c, vec3 a, vec3 b) {
   return c ? a : b;
 }

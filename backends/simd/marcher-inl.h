@@ -219,9 +219,7 @@ class Marcher {
 
   // Distance along each ray to where it leaves the band.
   FLATMARCH_PACKET_INLINE V band_exit(const Packet& r) const {
-    const M up = r.dz > Splat(0.0f);
-    const V s = Select(up, Splat(params_.top) - r.oz, hn::Neg(r.oz)) / r.dz;
-    return Select(up, s, Select(r.dz < Splat(0.0f), s, Splat(kFar)));
+    return lane::band_exit(params_.top, r.oz, r.dz).v;
   }
 
   // The rays of `m` reach the top or bottom of the band, `s` further on.
@@ -392,9 +390,7 @@ class Marcher {
     if (!Any(m)) return;
     const V height = Splat(params_.height), max_distance = Splat(params_.max_distance);
     const M above = r.oz > height;
-    const M toward = Select(above, r.dz<Splat(0.0f), r.dz> Splat(0.0f));
-    V s = Select(toward, (hn::IfThenElseZero(above, height) - r.oz) / r.dz, max_distance);
-    s = Select(s > max_distance, max_distance, s);
+    const V s = lane::band_entry(height, r.oz, r.dz, max_distance).v;
     const V qx = r.ox + s * r.dx, qy = r.oy + s * r.dy;
     M open = hn::And(m, s < max_distance);
     for (int k = 0; k < params_.polygon_count && Any(open); ++k) {

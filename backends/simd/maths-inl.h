@@ -68,8 +68,31 @@ HWY_INLINE real operator*(real a, real b) {
 HWY_INLINE real operator/(real a, real b) {
   return a.v / b.v;
 }
+HWY_INLINE real operator-(real a) {
+  return hn::Neg(a.v);
+}
 HWY_INLINE lane_bool operator>(real a, real b) {
   return {a.v > b.v};
+}
+HWY_INLINE lane_bool operator>=(real a, real b) {
+  return {a.v >= b.v};
+}
+HWY_INLINE lane_bool operator<(real a, real b) {
+  return {a.v < b.v};
+}
+HWY_INLINE lane_bool operator<=(real a, real b) {
+  return {a.v <= b.v};
+}
+// GLSL's logic on conditions per lane. Both sides are computed (no short circuit), as maths.glsl
+// expects of every choice.
+HWY_INLINE lane_bool operator&&(lane_bool a, lane_bool b) {
+  return {hn::And(a.m, b.m)};
+}
+HWY_INLINE lane_bool operator||(lane_bool a, lane_bool b) {
+  return {hn::Or(a.m, b.m)};
+}
+HWY_INLINE lane_bool operator!(lane_bool a) {
+  return {hn::Not(a.m)};
 }
 
 HWY_INLINE vec2 operator+(const vec2& a, const vec2& b) {
@@ -110,6 +133,15 @@ HWY_INLINE real min(real a, real b) {
 HWY_INLINE real max(real a, real b) {
   return hn::Max(a.v, b.v);
 }
+HWY_INLINE real clamp(real a, real lo, real hi) {  // GLM: min(max(a, lo), hi)
+  return min(max(a, lo), hi);
+}
+HWY_INLINE real floor(real a) {
+  return hn::Floor(a.v);
+}
+HWY_INLINE real mod(real a, real b) {  // GLM: a - b * floor(a / b)
+  return a - b * floor(a / b);
+}
 HWY_INLINE vec2 max(const vec2& a, const vec2& b) {
   return {max(a.x, b.x), max(a.y, b.y)};
 }
@@ -133,6 +165,9 @@ HWY_INLINE real length(const vec3& a) {
 }
 HWY_INLINE vec3 normalize(const vec3& a) {  // GLM: a * inversesqrt(dot(a, a))
   return a * (real(1.0f) / sqrt(dot(a, a)));
+}
+HWY_INLINE lane_bool select(lane_bool c, lane_bool a, lane_bool b) {
+  return {hn::Or(hn::And(c.m, a.m), hn::AndNot(c.m, b.m))};
 }
 HWY_INLINE real select(lane_bool c, real a, real b) {
   return Select(c.m, a.v, b.v);

@@ -44,10 +44,7 @@ HWY_INLINE void Shade(const KernelParams& params, const Packet& r,
   cb = Select(wall, grey, cb);
   const M floor = Equal(r.hit, kHitFloor);
   if (Any(floor)) {
-    const V check = hn::Floor(r.ox / Splat(kFloorCheck)) + hn::Floor(r.oy / Splat(kFloorCheck));
-    const V two = Splat(2.0f);
-    const V parity = check - two * hn::Floor(check / two);  // mod
-    const V tone = Select(parity >= Splat(1.0f), Splat(kFloorDarkGrey), grey);
+    const V tone = lane::floor_tone(lane::vec2(r.ox, r.oy)).v;
     cr = Select(floor, tone, cr);
     cg = Select(floor, tone, cg);
     cb = Select(floor, tone, cb);
@@ -68,10 +65,11 @@ HWY_INLINE void Shade(const KernelParams& params, const Packet& r,
         factor[l] = glm::pow(1.0f - params.wall_tint, static_cast<float>(crossings[l]));
     tr = hn::LoadU(D(), factor.data());
   }
-  const V fog = Splat(1.0f) - tr;
-  red = tr * cr + fog * Splat(params.fog.x);
-  green = tr * cg + fog * Splat(params.fog.y);
-  blue = tr * cb + fog * Splat(params.fog.z);
+  const lane::vec3 c =
+      lane::through_walls(lane::vec3(cr, cg, cb), tr, lane::vec3(lane::Broadcast(params.fog)));
+  red = c.x.v;
+  green = c.y.v;
+  blue = c.z.v;
 }
 
 // Number of lanes of this target's vectors: the packet size.

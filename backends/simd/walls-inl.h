@@ -125,25 +125,14 @@ class Walls {
     return v;
   }
 
-  // Whether the horizontal ray from p in +x crosses the edge from a to a + ab; ap = p - a,
-  // ay_aby = a.y + ab.y.
-  static FLATMARCH_PACKET_INLINE M crosses(V ay, V ay_aby, V abx, V aby, V py, V apx, V apy) {
-    const M over_a = py >= ay;
-    const M under_b = py < ay_aby;
-    const M left = abx * apy > aby * apx;
-    return hn::Or(hn::And(hn::And(over_a, under_b), left),
-                  hn::Not(hn::Or(hn::Or(over_a, under_b), left)));
-  }
-
   FLATMARCH_PACKET_INLINE M inside_polygon(int polygon, V px, V py) const {
     const ivec4 poly = polygons_[polygon];
     M inside = None();
     for (int k = poly.x; k < poly.x + poly.y; ++k) {
       const glm::vec4 s = edges_[k].segment;
       const glm::vec4 x = extra_[k];
-      const V apx = px - Splat(s.x), apy = py - Splat(s.y);
-      inside =
-          hn::Xor(inside, crosses(Splat(s.y), Splat(x.w), Splat(x.x), Splat(x.y), py, apx, apy));
+      const lane::vec2 ap(px - Splat(s.x), py - Splat(s.y));
+      inside = hn::Xor(inside, lane::crosses(py, s.y, x.w, ap, lane::vec2(x.x, x.y)).m);
     }
     return inside;
   }
@@ -162,15 +151,13 @@ class Walls {
       const V aby = field<kOneRoom>(at, kAby);
       const V w = field<kOneRoom>(at, kInvLength2);
       const V ay_aby = field<kOneRoom>(at, kAyAby);
-      const V apx = px - ax, apy = py - ay;
-      const V h = hn::Min(hn::Max((apx * abx + apy * aby) * w, Splat(0.0f)), Splat(1.0f));
-      const V qx = apx - h * abx, qy = apy - h * aby;
-      const V d2 = qx * qx + qy * qy;
+      const lane::vec2 ap(px - ax, py - ay), ab(abx, aby);
+      const V d2 = lane::segment_distance2(ap, ab, w).v;
       const M nearest = hn::And(valid, d2 < best);
       second = Select(nearest, best, Select(hn::And(valid, d2 < second), d2, second));
       best = Select(nearest, d2, best);
       edge = Select(nearest, SplatI(k), edge);
-      inside = hn::Xor(inside, hn::And(valid, crosses(ay, ay_aby, abx, aby, py, apx, apy)));
+      inside = hn::Xor(inside, hn::And(valid, lane::crosses(py, ay, ay_aby, ap, ab).m));
     }
     WallDistance w;
     const V root = hn::Sqrt(best);
@@ -188,15 +175,15 @@ class Walls {
     x.edge = SplatI(-1);
     V u_exit = Splat(0.5f), tolerance_exit = Splat(0.0f);  // of the exit edge found so far
     const V vertex_tolerance = Splat(params_.vertex_tolerance);
+    const lane::vec2 o(ox, oy), dh(dhx, dhy);
     for (int k = 0; k < rooms.most_edges; ++k) {
       const Slot at = slot<kOneRoom>(rooms, k);
-      const V nx = field<kOneRoom>(at, kNx);
-      const V ny = field<kOneRoom>(at, kNy);
-      const V dn = dhx * nx + dhy * ny;
+      const lane::vec2 n(field<kOneRoom>(at, kNx), field<kOneRoom>(at, kNy));
+      const V dn = lane::dot(dh, n).v;
       const M towards = hn::And(hn::And(m, at.valid), dn > Splat(0.0f));
       if (!Any(towards)) continue;
       const V nz = field<kOneRoom>(at, kNa);
-      const V s = (nz - (ox * nx + oy * ny)) / dn;
+      const V s = lane::line_distance(o, n, nz, dn).v;
       // No test whether any ray meets this edge's line before its exit so far: the branch
       // mispredicts in packets whose rays are at different steps of their march (with it, the
       // analytic frames were 2-6% slower).
@@ -206,16 +193,17 @@ class Walls {
       const V abx = field<kOneRoom>(at, kAbx);
       const V aby = field<kOneRoom>(at, kAby);
       const V w = field<kOneRoom>(at, kInvLength2);
-      const V u = (((ox + s * dhx) - ax) * abx + ((oy + s * dhy) - ay) * aby) * w;
+      const V u =
+          lane::edge_parameter(o + lane::real(s) * dh, lane::vec2(ax, ay), lane::vec2(abx, aby), w)
+              .v;
       const V tolerance = field<kOneRoom>(at, kTolerance);
-      ok =
-          hn::AndNot(hn::Or(hn::Lt(u, hn::Neg(tolerance)), hn::Gt(u, Splat(1.0f) + tolerance)), ok);
+      ok = hn::And(ok, lane::on_edge(u, tolerance).m);
       x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
       x.edge = Select(ok, SplatI(k), x.edge);
       u_exit = Select(ok, u, u_exit);
       tolerance_exit = Select(ok, tolerance, tolerance_exit);
     }
-    x.corner = hn::Or(u_exit <= tolerance_exit, u_exit >= Splat(1.0f) - tolerance_exit);
+    x.corner = lane::near_end(u_exit, tolerance_exit).m;
     return x;
   }
 
