@@ -79,8 +79,7 @@ class Marcher {
     // The normal and surface colour are left: only a ray that hits a solid reads them, and the
     // hit sets them.
     if (has(kFeaturePeriod)) {
-      const V top = Splat(params_.top);
-      r.oz = Select(m, r.oz - top * hn::Floor(r.oz / top), r.oz);  // mod
+      r.oz = Select(m, lane::mod(r.oz, params_.top).v, r.oz);
     } else {
       const M below = hn::Lt(r.oz, Splat(0.0f)), above = hn::Gt(r.oz, Splat(params_.height));
       enter_band(r, hn::And(m, hn::Or(below, above)));
