@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "backends/kernel_trace.hpp"
@@ -57,6 +59,11 @@ const char* to_string(Method m) {
 std::optional<Method> parse_method(const std::string& name) {
   return value_of(kMethods, name);
 }
+std::string method_names() {
+  std::string names;
+  for (const auto& [m, name] : kMethods) names += (names.empty() ? "" : ", ") + std::string(name);
+  return names;
+}
 const char* to_string(EventKind k) {
   return name_of(kEventKinds, k);
 }
@@ -95,22 +102,69 @@ Trace shader_trace(const unsigned char* buffer, int max_events) {
 }
 
 namespace {
-constexpr std::array<const char*, 5> kBackendNames{"oracle", "scalar", "simd", "opengl", "vulkan"};
+
+std::vector<BackendEntry>& registry() {
+  static std::vector<BackendEntry> entries{
+      {.name = "oracle",
+       .kernel = false,
+       .reference_for = "the true image and every ray's path (exact, analytic)",
+       .make = [](const BackendOptions&) { return std::make_unique<OracleBackend>(); }},
+      {.name = "scalar",
+       .reference_for = "the kernel's steps: every other kernel backend's traces are compared "
+                        "with its",
+       .make = [](const BackendOptions&) { return std::make_unique<ScalarBackend>(); }},
+      {.name = "simd",
+       .make = [](const BackendOptions& o) { return std::make_unique<SimdBackend>(o); }},
+      {.name = "opengl",
+       .make = [](const BackendOptions& o) { return std::make_unique<OpenGlBackend>(o); }},
+      {.name = "vulkan",
+       .make = [](const BackendOptions& o) { return std::make_unique<VulkanBackend>(o); }},
+  };
+  return entries;
+}
+
+bool backends_made = false;  // backends() has made its list: the registry is closed
+
 }  // namespace
 
+const std::vector<BackendEntry>& backend_registry() {
+  return registry();
+}
+
+bool register_backend(BackendEntry entry) {
+  if (backends_made)
+    throw std::logic_error("register_backend(" + entry.name + "): after backends() was called");
+  for (const BackendEntry& e : registry())
+    if (e.name == entry.name)
+      throw std::logic_error("register_backend: a backend named " + entry.name + " exists");
+  registry().push_back(std::move(entry));
+  return true;
+}
+
+std::vector<std::string> backend_names() {
+  std::vector<std::string> names;
+  for (const BackendEntry& e : registry()) names.push_back(e.name);
+  return names;
+}
+
+std::vector<std::string> kernel_backend_names() {
+  std::vector<std::string> names;
+  for (const BackendEntry& e : registry())
+    if (e.kernel) names.push_back(e.name);
+  return names;
+}
+
 std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOptions& options) {
-  if (name == "oracle") return std::make_unique<OracleBackend>();
-  if (name == "scalar") return std::make_unique<ScalarBackend>();
-  if (name == "simd") return std::make_unique<SimdBackend>(options);
-  if (name == "opengl") return std::make_unique<OpenGlBackend>(options);
-  if (name == "vulkan") return std::make_unique<VulkanBackend>(options);
+  for (const BackendEntry& e : registry())
+    if (e.name == name) return e.make(options);
   return nullptr;
 }
 
 const std::vector<std::unique_ptr<Backend>>& backends() {
   static const std::vector<std::unique_ptr<Backend>> all = [] {
+    backends_made = true;
     std::vector<std::unique_ptr<Backend>> v;
-    for (const char* name : kBackendNames) v.push_back(make_backend(name, {}));
+    for (const BackendEntry& e : registry()) v.push_back(e.make({}));
     return v;
   }();
   return all;

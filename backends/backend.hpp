@@ -17,6 +17,8 @@ namespace flatmarch {
 
 const char* to_string(Method m);
 std::optional<Method> parse_method(const std::string& name);
+// Every method's name, in order, joined by ", " (for help texts and errors).
+std::string method_names();
 
 // One ray, in the coordinates of `polygon` (ignored when `from` lies outside every wall band).
 struct Ray {
@@ -183,7 +185,32 @@ class Backend {
                       int max_events) const = 0;
 };
 
-// All backends this build knows, available here or not, with default options.
+// ---- The registry -----------------------------------------------------------------------------
+// Every list of backends in the project (the CLI's, the conformance suite's and its tests', the
+// report's and the benchmarks') is read from here: adding a backend is adding an entry.
+
+// A backend as the project's lists know it.
+struct BackendEntry {
+  std::string name;
+  // Runs the march kernel: the conformance suite, the report and the benchmarks measure it
+  // against the oracle. (The oracle is the one backend that does not.)
+  bool kernel = true;
+  // What its results are the reference for, where they are one (`flatmarch backends` says).
+  std::string reference_for{};
+  std::function<std::unique_ptr<Backend>(const BackendOptions&)> make;
+};
+
+// The registered backends: the built-in ones, then any a program added.
+const std::vector<BackendEntry>& backend_registry();
+// Adds a backend after the built-in ones (a test's own backend, registered by a static
+// initialiser). Throws std::logic_error on a name already taken, or once backends() has been
+// called.
+bool register_backend(BackendEntry entry);
+// The names of the registered backends, and of those that run the kernel.
+std::vector<std::string> backend_names();
+std::vector<std::string> kernel_backend_names();
+
+// All registered backends, available here or not, with default options.
 const std::vector<std::unique_ptr<Backend>>& backends();
 const Backend* find_backend(const std::string& name);
 // A backend by name with the given options; null if there is none of that name.

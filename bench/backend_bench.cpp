@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   reports::add_to_benchmark_context(reports::hardware_fingerprint());
   const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
   std::vector<std::unique_ptr<Backend>> available;
-  for (const char* name : {"oracle", "scalar", "simd", "opengl", "vulkan"}) {
+  for (const std::string& name : backend_names()) {
     std::unique_ptr<Backend> b = make_backend(name, {});
     if (const Availability a = b->availability(); !a.available)
       std::cerr << "backend_bench: the " << name

@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
     for (const Backend* backend : available)
-      for (Method method : {Method::sphere, Method::relaxed, Method::analytic}) {
+      for (Method method : kKernelMethods) {
         MarchParams params;
         params.method = method;
         benchmark::RegisterBenchmark(
@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
       }
   }
   for (const bench::Size size : bench::kSizes)
-    for (Method method : {Method::sphere, Method::relaxed, Method::analytic})
+    for (Method method : kKernelMethods)
       for (const auto& scene : scenes)
         for (const Backend* backend : available) {
           MarchParams params;

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   };
-  for (Method method : {Method::sphere, Method::relaxed, Method::analytic}) {
+  for (Method method : kKernelMethods) {
     for (const auto& scene : scenes) {
       const bool compared = scene->name == "l_shape" || scene->name == "double_pentagon";
       if (compared || scene->name == "cube" || scene->name == "staircase_32") {

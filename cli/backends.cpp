@@ -19,7 +19,9 @@ void add_backends(CLI::App& app) {
   cmd->add_flag("--json", *json, "Print JSON instead of a table");
   cmd->callback([json] {
     nlohmann::json list = nlohmann::json::array();
-    for (const auto& b : backends()) {
+    const std::vector<BackendEntry>& registry = backend_registry();
+    for (size_t k = 0; k < backends().size(); ++k) {
+      const auto& b = backends()[k];
       const Availability a = b->availability();
       nlohmann::json methods = nlohmann::json::array();
       for (Method m : b->methods()) methods.push_back(to_string(m));
@@ -27,7 +29,9 @@ void add_backends(CLI::App& app) {
                       {"available", a.available},
                       {"reason", a.reason},
                       {"methods", methods},
-                      {"description", b->description()}});
+                      {"description", b->description()},
+                      {"kernel", registry[k].kernel},
+                      {"reference_for", registry[k].reference_for}});
       if (b->name() == "simd") list.back()["isas"] = simd::isa_names(true);
       if (const auto device = b->device())
         list.back()["device"] = {{"name", device->name},         {"type", device->type},
@@ -77,6 +81,11 @@ void add_backends(CLI::App& app) {
                       : "unavailable: " + b["reason"].get<std::string>())
                       .c_str());
     }
+    std::printf("\n");
+    for (const auto& b : list)
+      if (const std::string r = b["reference_for"].get<std::string>(); !r.empty())
+        std::printf("%s is the reference for %s\n", b["name"].get<std::string>().c_str(),
+                    r.c_str());
     std::string isas;
     for (const std::string& name : simd::isa_names(true)) isas += (isas.empty() ? "" : ", ") + name;
     std::printf("\nsimd instruction sets this CPU runs (--isa), best first: %s\n", isas.c_str());

@@ -78,7 +78,7 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
                  "Backend: " + names + " (see `flatmarch backends`); default: " + default_name +
                      (fallback != default_name ? " where available, else " + fallback : ""));
   app.add_option("--method", method,
-                 "Method: sphere, relaxed, analytic, oracle (default: the backend's first)");
+                 "Method: " + method_names() + " (default: the backend's first)");
   app.add_option("--eps", params.eps, "Hit threshold")->capture_default_str();
   app.add_option("--offset", params.offset, "Re-entry push after a gluing")->capture_default_str();
   app.add_option("--max-steps", params.max_steps, "Kernel iterations before a ray gives up")
@@ -157,8 +157,7 @@ const Backend& MarchOptions::resolve() {
   } else {
     const auto m = parse_method(method);
     if (!m)
-      throw UsageError("--method: unknown method \"" + method +
-                       "\" (sphere, relaxed, analytic, oracle)");
+      throw UsageError("--method: unknown method \"" + method + "\" (" + method_names() + ")");
     if (std::find(methods.begin(), methods.end(), *m) == methods.end())
       throw UsageError("--method: backend " + backend + " does not run method " + method);
     params.method = *m;
@@ -248,7 +247,7 @@ std::vector<Method> parse_methods(const std::vector<std::string>& names) {
       throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + name + "\"");
     methods.push_back(*m);
   }
-  if (methods.empty()) methods = {Method::sphere, Method::relaxed, Method::analytic};
+  if (methods.empty()) methods.assign(kKernelMethods.begin(), kKernelMethods.end());
   return methods;
 }
 

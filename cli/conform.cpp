@@ -108,7 +108,7 @@ void add_conform(CLI::App& app) {
         sphere.method = Method::sphere;
         warn_about_resolution(scene, sphere);
       }
-    if (o->backends.empty()) o->backends = {"scalar", "simd", "opengl", "vulkan"};
+    if (o->backends.empty()) o->backends = kernel_backend_names();
     nlohmann::json thresholds = conformance::builtin_thresholds();
     if (!o->thresholds.empty()) {
       try {

@@ -1,6 +1,8 @@
 // The march parameters of DESIGN.md section 3, as every backend and the scene compiler take them.
 #pragma once
 
+#include <array>
+
 namespace flatmarch {
 
 // A ray passing within this distance of a vertex meets it (DESIGN.md section 3).
@@ -8,6 +10,11 @@ inline constexpr double kVertexTolerance = 1e-12;
 
 enum class Method { sphere, relaxed, analytic, oracle };
 enum class Precision { f32, f64 };
+
+// The methods the march kernel runs, in the order every list shows them (the oracle backend runs
+// Method::oracle alone). Every list of methods in the project is read from here.
+inline constexpr std::array<Method, 3> kKernelMethods{Method::sphere, Method::relaxed,
+                                                      Method::analytic};
 
 struct MarchParams {
   Method method = Method::sphere;

@@ -23,10 +23,37 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.colors import LogNorm  # noqa: E402
 from matplotlib.patheffects import withStroke  # noqa: E402
 
-BACKEND_COLOURS = {"scalar": "#1f77b4", "simd": "#2ca02c", "opengl": "#d62728", "vulkan": "#9467bd"}
-METHOD_MARKERS = {"sphere": "o", "relaxed": "s", "analytic": "^"}
+# The kernel's backends and methods, in the order flatmarch lists them: read from the results'
+# "registry" (use_registry), never restated here. Each gets a colour or marker by its place.
+METHODS = []
+BACKEND_COLOURS = {}
+METHOD_MARKERS = {}
+PALETTE = ["#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"]
+MARKERS = ["o", "s", "^", "D", "v", "P"]
 SURFACE_TYPES = ["prism", "mirror", "dilation", "reflection", "rotation", "translation"]
 FAILURES = ["stuck", "wrong_edge", "missed_object", "phantom_hit", "early_escape", "late_escape", "leak"]
+
+
+def use_registry(all_results):
+    """Takes the backend and method lists from the results (the first that carries them; results
+    written before they did: the backends and methods their cases name, in order of appearance)."""
+    backends, methods = [], []
+    for r in all_results:
+        if "registry" in r:
+            backends, methods = r["registry"]["backends"], r["registry"]["methods"]
+            break
+    if not backends:
+        for r in all_results:
+            for c in r.get("matrix", {}).get("cases", []):
+                if c["backend"] not in backends:
+                    backends.append(c["backend"])
+                if c["method"] not in methods:
+                    methods.append(c["method"])
+    METHODS[:] = methods
+    BACKEND_COLOURS.clear()
+    BACKEND_COLOURS.update({b: PALETTE[k % len(PALETTE)] for k, b in enumerate(backends)})
+    METHOD_MARKERS.clear()
+    METHOD_MARKERS.update({m: MARKERS[k % len(MARKERS)] for k, m in enumerate(methods)})
 
 
 def esc(text):
@@ -118,7 +145,7 @@ def ranking_section(results):
         parts.append(table(["surface type", "eps", "offset", "from"], rows))
     else:
         parts.append(f'<p class="bad">No recommendation: {esc(rec.get("why", ""))}</p>')
-    methods = ["sphere", "relaxed", "analytic"]
+    methods = METHODS
     rows = []
     for b in results.get("ranking", []):
         row = [b["rank"], b["backend"], device_text(b), mrays(b["rays_per_s"]),
@@ -222,7 +249,7 @@ def steps_heatmap_section(cases):
             if "lane_utilisation" in c.get("counters", {})}
     lane_table = ""
     if simd:
-        methods = [m for m in ["sphere", "relaxed", "analytic"] if any(k[1] == m for k in simd)]
+        methods = [m for m in METHODS if any(k[1] == m for k in simd)]
 
         def cell(counters):
             text = pct(counters["lane_utilisation"]) + " lanes"
@@ -296,7 +323,7 @@ def sweep_section(sweep):
     types = [t for t in SURFACE_TYPES if any(g["surface_type"] == t for g in analysis)]
     for t in types:
         groups = [g for g in analysis if g["surface_type"] == t]
-        methods = [m for m in ["sphere", "relaxed", "analytic"] if any(g["method"] == m for g in groups)]
+        methods = [m for m in METHODS if any(g["method"] == m for g in groups)]
         precisions = [p for p in ["f32", "f64"] if any(g["precision"] == p for g in groups)]
         scenes = sorted({p["scene"] for p in sweep["points"] if p["surface_type"] == t})
         out.append(f"<h3>{esc(t)} surfaces ({esc(', '.join(scenes))})</h3>")
@@ -527,6 +554,7 @@ def main():
         with open(path) as f:
             all_results.append(json.load(f))
     os.makedirs(args.out, exist_ok=True)
+    use_registry(all_results)
     if len(all_results) == 1:
         images = os.path.join(os.path.dirname(os.path.abspath(args.results[0])), "images")
         page = one_machine(all_results[0], images)

@@ -19,9 +19,9 @@
 namespace flatmarch::reports {
 
 struct MatrixOptions {
-  std::vector<std::string> backends = {"scalar", "simd", "opengl", "vulkan"};
+  std::vector<std::string> backends = kernel_backend_names();
   BackendOptions backend_options;
-  std::vector<Method> methods = {Method::sphere, Method::relaxed, Method::analytic};
+  std::vector<Method> methods{kKernelMethods.begin(), kKernelMethods.end()};
   MarchParams params;             // eps, offset, ...; the method is each case's
   int width = 256, height = 144;  // timed frames
   int conform_width = 160, conform_height = 90;

@@ -37,6 +37,10 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
   json results = {{"format", "flatmarch-report/1"}, {"created", now_utc()}};
   results["fingerprint"] = hardware_fingerprint();
   add_to_benchmark_context(results["fingerprint"]);
+  // The lists make_report.py draws by (it restates none).
+  json methods = json::array();
+  for (Method m : kKernelMethods) methods.push_back(to_string(m));
+  results["registry"] = {{"backends", kernel_backend_names()}, {"methods", methods}};
   results["options"] = {
       {"size", std::to_string(o.matrix.width) + "x" + std::to_string(o.matrix.height)},
       {"conform_size",

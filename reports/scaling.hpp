@@ -21,7 +21,7 @@ struct ScalingOptions {
   // The scene of the resolution series (the gallery torus); unset: empty_torus_prism().
   std::optional<Scene> resolution_scene;
   BackendOptions backend_options;
-  std::vector<Method> methods = {Method::sphere, Method::relaxed, Method::analytic};
+  std::vector<Method> methods{kKernelMethods.begin(), kKernelMethods.end()};
   std::vector<int> polygon_n = {2, 4, 8, 16, 32};  // regular 2n-gons
   std::vector<int> staircase_squares = {2, 4, 8, 16, 32};
   std::vector<std::pair<int, int>> resolutions = {{80, 45}, {160, 90}, {320, 180}, {640, 360}};

@@ -22,7 +22,7 @@ struct SweepOptions {
   std::vector<double> eps = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
   std::vector<double> offset_factors = {0.5, 1.0, 2.0, 5.0, 10.0};  // offset = factor x eps
   std::vector<double> offset_fixed = {1e-4, 1e-2};                  // and these, whatever eps
-  std::vector<Method> methods = {Method::sphere, Method::relaxed, Method::analytic};
+  std::vector<Method> methods{kKernelMethods.begin(), kKernelMethods.end()};
   std::vector<Precision> precisions = {Precision::f32, Precision::f64};  // those it has
   MarchParams params;  // max_steps, max_distance, omega
   int width = 64, height = 36;

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "backends/backend.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
@@ -20,12 +21,13 @@ TEST(CliScalar, RendersAndTracesEveryGalleryScene) {
   // Each method on a third of the scenes keeps the run short; the conformance tests render
   // every scene with every method through the same backend.
   const fs::path dir = test::make_temp_dir();
-  const std::string methods[] = {"sphere", "relaxed", "analytic"};
+  std::vector<std::string> methods;
+  for (Method m : kKernelMethods) methods.push_back(to_string(m));
   std::vector<std::string> scenes;
   for (const auto& file : test::gallery_files()) scenes.push_back(file.string());
   for (size_t k = 0; k < scenes.size(); ++k) {
     const std::string& scene = scenes[k];
-    const std::string& method = methods[k % 3];
+    const std::string& method = methods[k % methods.size()];
     const fs::path out = dir / (fs::path(scene).stem().string() + ".png");
     const auto r = test::run_flatmarch({"render", scene, "-o", out.string(), "--size", "32x18",
                                         "--backend", "scalar", "--method", method});
@@ -34,10 +36,10 @@ TEST(CliScalar, RendersAndTracesEveryGalleryScene) {
     EXPECT_TRUE(fs::exists(fs::path(out).replace_extension(".exr")));
     // A ray from the scene's camera.
     const Camera camera = load_scene(scene).camera;
-    const auto t =
-        test::run_flatmarch({"trace", scene, "--polygon", std::to_string(camera.polygon), "--from",
-                             test::vec3_arg(camera.position), "--dir", "1,0.3,-0.2", "--backend",
-                             "scalar", "--method", methods[(k + 1) % 3], "--precision", "f64"});
+    const auto t = test::run_flatmarch({"trace", scene, "--polygon", std::to_string(camera.polygon),
+                                        "--from", test::vec3_arg(camera.position), "--dir",
+                                        "1,0.3,-0.2", "--backend", "scalar", "--method",
+                                        methods[(k + 1) % methods.size()], "--precision", "f64"});
     ASSERT_EQ(t.exit_code, 0) << scene << ": " << t.err;
     const nlohmann::json trace = nlohmann::json::parse(t.out);
     EXPECT_EQ(trace["backend"], "scalar");

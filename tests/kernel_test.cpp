@@ -173,7 +173,7 @@ TEST(FailureModes, ARayIntoACornerEndsAtTheVertex) {
   const Trace truth = OracleBackend().trace(s, Ray{0, {2, 2, 1}, {1, 1, 0}}, {}, 8);
   ASSERT_EQ(truth.events.size(), 1u);
   EXPECT_EQ(truth.events[0].kind, EventKind::vertex);
-  for (Method m : {Method::sphere, Method::relaxed, Method::analytic}) {
+  for (Method m : kKernelMethods) {
     const Trace tr = scalar_trace(s, {2, 2, 1}, {1, 1, 0}, with(m));
     ASSERT_EQ(tr.events.size(), 1u) << to_string(m);
     EXPECT_EQ(tr.events[0].kind, EventKind::vertex) << to_string(m);

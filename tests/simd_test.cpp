@@ -77,7 +77,7 @@ TEST_P(SimdAgainstScalar, HitAndStepsAgree) {
 std::vector<Case> every_case() {
   std::vector<Case> cases;
   for (const std::string& name : test::gallery_names())
-    for (Method m : {Method::sphere, Method::relaxed, Method::analytic}) cases.push_back({name, m});
+    for (Method m : kKernelMethods) cases.push_back({name, m});
   return cases;
 }
 
@@ -137,7 +137,7 @@ TEST(Simd, TracesMatchScalar) {
     const Scene& scene = test::gallery_scene(name);
     const Camera& c = scene.camera;
     const CameraBasis<double> basis = camera_basis<double>(c.yaw_deg, c.pitch_deg, c.fov_deg, 8, 5);
-    for (Method m : {Method::sphere, Method::relaxed, Method::analytic}) {
+    for (Method m : kKernelMethods) {
       MarchParams params;
       params.method = m;
       for (int i : {1, 4, 6}) {

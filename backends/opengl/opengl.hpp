@@ -23,7 +23,7 @@ class OpenGlBackend final : public Backend {
   std::string description() const override;
   Availability availability() const override;
   std::vector<Method> methods() const override {
-    return {Method::sphere, Method::relaxed, Method::analytic};
+    return {kKernelMethods.begin(), kKernelMethods.end()};
   }
   std::vector<Precision> precisions() const override { return {Precision::f32}; }
   std::optional<DeviceInfo> device() const override;

@@ -12,7 +12,7 @@ class ScalarBackend final : public Backend {
   std::string description() const override;
   Availability availability() const override { return {}; }
   std::vector<Method> methods() const override {
-    return {Method::sphere, Method::relaxed, Method::analytic};
+    return {kKernelMethods.begin(), kKernelMethods.end()};
   }
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;

@@ -27,7 +27,7 @@ class SimdBackend final : public Backend {
   std::string description() const override;
   Availability availability() const override;
   std::vector<Method> methods() const override {
-    return {Method::sphere, Method::relaxed, Method::analytic};
+    return {kKernelMethods.begin(), kKernelMethods.end()};
   }
   std::vector<Precision> precisions() const override { return {Precision::f32}; }
   Frame render(const Scene& scene, const Camera& camera, int width, int height,

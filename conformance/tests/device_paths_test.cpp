@@ -138,8 +138,7 @@ TEST_P(DevicePaths, VulkanDirectAndStagingReadBacksAgree) {
 std::vector<Case> cases() {
   std::vector<Case> all;
   for (const auto& file : scene_files())
-    for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
-      all.push_back({file.stem().string(), m});
+    for (Method m : kKernelMethods) all.push_back({file.stem().string(), m});
   return all;
 }
 

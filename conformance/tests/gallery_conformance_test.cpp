@@ -71,13 +71,11 @@ TEST_P(GalleryConformance, MeetsItsThresholds) {
 
 std::vector<Case> cases() {
   std::vector<Case> all;
-  for (const std::string backend : {"scalar", "simd", "opengl", "vulkan"})
+  for (const std::string& backend : kernel_backend_names())
     for (const std::string& name : scene_names())
-      for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
-        all.push_back({backend, name, m});
+      for (Method m : kKernelMethods) all.push_back({backend, name, m});
   for (const std::string& name : scene_names())  // float64, on the reference CPU backend
-    for (Method m : {Method::sphere, Method::relaxed, Method::analytic})
-      all.push_back({"scalar", name, m, Precision::f64});
+    for (Method m : kKernelMethods) all.push_back({"scalar", name, m, Precision::f64});
   return all;
 }
 

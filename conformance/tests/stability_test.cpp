@@ -140,7 +140,7 @@ TEST_P(Stability, ThroughAndNearAConePoint) {
                                glm::normalize(polygon.vertex(corner.vertex - 1) - v));
   if (!polygon.contains(v + 0.3 * inward)) inward = -inward;
   const Vec3 from(v + 0.3 * inward, 1.0);
-  for (const Method m : {Method::sphere, Method::relaxed, Method::analytic}) {
+  for (const Method m : kKernelMethods) {
     const MarchParams p = with(m);
     const double delta = ambiguity_delta(scene, p);
     const Vec2 to_v = glm::normalize(v - Vec2(from));
@@ -177,7 +177,7 @@ TEST_P(Stability, PastAReflexCorner) {
   const Vec2 v = polygon.vertex(reflex);
   // From (0.5, 0.5) diagonally past the corner, d to the side of it: beyond it, one side goes
   // on into the upper arm, the other into the lower one.
-  for (const Method m : {Method::sphere, Method::relaxed, Method::analytic}) {
+  for (const Method m : kKernelMethods) {
     const MarchParams p = with(m);
     for (const double d : {-0.3 * p.eps, 0.3 * p.eps, -10.0 * ambiguity_delta(scene, p),
                            10.0 * ambiguity_delta(scene, p), 0.05}) {
@@ -364,7 +364,7 @@ TEST_P(Stability, EpsBelowFloat32ResolutionAtTheScenesScale) {
   EXPECT_LT(stuck(r64), stuck(r32) / 5.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, Stability, testing::Values("scalar", "simd", "opengl", "vulkan"),
+INSTANTIATE_TEST_SUITE_P(Backends, Stability, testing::ValuesIn(kernel_backend_names()),
                          [](const testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace
