@@ -1,0 +1,121 @@
+// What every kernel backend promises, tested once over the registry (backend_registry()): a
+// backend registered there, a test's own included, is held to all of it with no other edit.
+// Each backend's own test file keeps only what is specific to it (devices, shaders, ISAs,
+// threads). A backend unavailable here is skipped, visibly, with its reason.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "backends/backend.hpp"
+#include "backends/scalar/scalar.hpp"
+#include "tests/gallery.hpp"
+#include "tests/oracle_compare.hpp"
+
+namespace flatmarch {
+namespace {
+
+class BackendContract : public testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    backend_ = make_backend(GetParam(), {});
+    ASSERT_NE(backend_, nullptr) << GetParam() << " is registered but makes no backend";
+    if (const Availability a = backend_->availability(); !a.available)
+      GTEST_SKIP() << "the " << GetParam() << " backend is unavailable here: " << a.reason;
+  }
+
+  // How far a backend may stray from the scalar kernel, and why.
+  // CPU backends compile the kernel with the scalar backend's float operations in the same order
+  // (no fused multiply-add): they agree exactly. A device compiles the shader with its own
+  // compiler, which may fuse, reorder or round square roots differently: a ray grazing an edge
+  // or a vertex may then take a step more or less, or go the other way.
+  int step_tolerance() const { return backend_->device() ? 2 : 0; }
+  size_t pixel_tolerance() const { return backend_->device() ? 6 : 0; }
+
+  std::unique_ptr<Backend> backend_;
+};
+
+TEST_P(BackendContract, TraceMatchesTheScalarKernelsSteps) {
+  const Scene& scene = test::gallery_scene("l_shape");
+  for (const Method m : backend_->methods()) {
+    MarchParams params;
+    params.method = m;
+    for (const Ray& ray : test::generic_rays(scene)) {
+      const Trace want = ScalarBackend().trace(scene, ray, params, 50);
+      const Trace got = backend_->trace(scene, ray, params, 50);
+      EXPECT_NEAR(got.steps, want.steps, step_tolerance()) << to_string(m);
+      ASSERT_EQ(got.events.size(), want.events.size()) << to_string(m);
+      for (size_t k = 0; k < want.events.size(); ++k)
+        EXPECT_EQ(got.events[k].kind, want.events[k].kind)
+            << to_string(m) << ", event " << k << ": " << test::describe(got.events[k])
+            << " where the scalar kernel has " << test::describe(want.events[k]);
+    }
+  }
+}
+
+TEST_P(BackendContract, RefusesWhatItCannotMarchAndSaysWhy) {
+  const Scene& scene = test::gallery_scene("torus");
+  const std::vector<Precision> precisions = backend_->precisions();
+  for (const Precision p : {Precision::f32, Precision::f64}) {
+    if (std::find(precisions.begin(), precisions.end(), p) != precisions.end()) continue;
+    MarchParams params;
+    params.precision = p;
+    try {
+      backend_->render(scene, scene.camera, 8, 8, params, {});
+      ADD_FAILURE() << "rendered in a precision it does not list";
+    } catch (const std::invalid_argument& e) {
+      // It names itself and what it does march in.
+      const std::string why = e.what();
+      EXPECT_NE(why.find(GetParam()), std::string::npos) << why;
+      EXPECT_NE(why.find(p == Precision::f64 ? "f32" : "f64"), std::string::npos) << why;
+    }
+  }
+}
+
+TEST_P(BackendContract, ReportsProgressRisingToTheEnd) {
+  const Scene& scene = test::gallery_scene("torus");
+  std::vector<double> seen;
+  backend_->render(scene, scene.camera, 32, 200, {}, [&](double f) { seen.push_back(f); });
+  ASSERT_FALSE(seen.empty());
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GE(seen.front(), 0.0);
+  EXPECT_DOUBLE_EQ(seen.back(), 1.0);
+}
+
+TEST_P(BackendContract, ImageRowsAreTopDownAsDesignSays) {
+  // In the cube the bottom rows see the floor and the top rows the open sky over the walls: an
+  // image far from symmetric top to bottom, so rows stored bottom-up would not agree with the
+  // scalar backend's.
+  const Scene& scene = test::gallery_scene("cube");
+  Camera camera = scene.camera;
+  camera.pitch_deg = 0.0;
+  constexpr int kWidth = 40, kHeight = 30;
+  const Frame want = ScalarBackend().render(scene, camera, kWidth, kHeight, {}, {});
+  const Frame got = backend_->render(scene, camera, kWidth, kHeight, {}, {});
+  ASSERT_EQ(got.width, kWidth);
+  ASSERT_EQ(got.height, kHeight);
+  size_t differ = 0, mirrored = 0;
+  for (int j = 0; j < kHeight; ++j)
+    for (int i = 0; i < kWidth; ++i) {
+      differ += got.hit[got.pixel(i, j)] != want.hit[want.pixel(i, j)];
+      mirrored += got.hit[got.pixel(i, j)] == want.hit[want.pixel(i, kHeight - 1 - j)];
+    }
+  EXPECT_LE(differ, pixel_tolerance());
+  EXPECT_LT(mirrored, got.hit.size() / 2);  // the test would not see a flip otherwise
+}
+
+TEST_P(BackendContract, ARepeatedFrameIsTheSame) {
+  const Scene& scene = test::gallery_scene("l_shape");
+  const Frame a = backend_->render(scene, scene.camera, 48, 27, {}, {});
+  const Frame b = backend_->render(scene, scene.camera, 48, 27, {}, {});
+  EXPECT_TRUE(a.hit == b.hit && a.steps == b.steps && a.t == b.t && a.rgb == b.rgb);
+}
+
+INSTANTIATE_TEST_SUITE_P(Registered, BackendContract, testing::ValuesIn(kernel_backend_names()),
+                         [](const testing::TestParamInfo<std::string>& p) { return p.param; });
+
+}  // namespace
+}  // namespace flatmarch
