@@ -103,6 +103,23 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
                "where the device's memory is host-visible");
 }
 
+Precision parse_precision(const std::string& text) {
+  if (text == "f32") return Precision::f32;
+  if (text == "f64") return Precision::f64;
+  throw UsageError("--precision: expected f32 or f64, got \"" + text + "\"");
+}
+
+std::unique_ptr<Backend> make_kernel_backend(const std::string& name,
+                                             const BackendOptions& options) {
+  const std::vector<std::string> kernel = kernel_backend_names();
+  std::unique_ptr<Backend> backend = make_backend(name, options);
+  if (!backend)
+    throw UsageError("--backend: unknown backend \"" + name + "\" (see `flatmarch backends`)");
+  if (std::find(kernel.begin(), kernel.end(), name) == kernel.end())
+    throw UsageError("--backend: the " + name + " is what the others are measured against");
+  return backend;
+}
+
 void check_march_params(const MarchParams& params) {
   if (!(params.eps > 0.0) || !std::isfinite(params.eps))
     throw UsageError("--eps: must be a positive number");
@@ -162,12 +179,7 @@ const Backend& MarchOptions::resolve() {
       throw UsageError("--method: backend " + backend + " does not run method " + method);
     params.method = *m;
   }
-  if (precision == "f32")
-    params.precision = Precision::f32;
-  else if (precision == "f64")
-    params.precision = Precision::f64;
-  else
-    throw UsageError("--precision: expected f32 or f64, got \"" + precision + "\"");
+  params.precision = parse_precision(precision);
   const std::vector<Precision> precisions = b->precisions();
   if (std::find(precisions.begin(), precisions.end(), params.precision) == precisions.end())
     throw UsageError("--precision: backend " + backend + " does not march in " + precision);

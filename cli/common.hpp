@@ -44,6 +44,14 @@ std::vector<Scene> load_scenes(const std::vector<std::string>& names,
 // none is named.
 std::vector<Method> parse_methods(const std::vector<std::string>& names);
 
+// The precision --precision names: f32 or f64 (UsageError for another).
+Precision parse_precision(const std::string& text);
+
+// The kernel backend --backend names, made with `options`: UsageError for an unknown name, or a
+// backend that does not run the kernel (the oracle, which the others are measured against).
+std::unique_ptr<Backend> make_kernel_backend(const std::string& name,
+                                             const BackendOptions& options);
+
 // Throws UsageError for parameters out of range; warns (stderr) when offset <= eps.
 void check_march_params(const MarchParams& params);
 

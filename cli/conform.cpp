@@ -96,10 +96,7 @@ void add_conform(CLI::App& app) {
   cmd->callback([o] {
     const auto [w, h] = parse_size("--size", o->size);
     check_march_params(o->params);
-    if (o->precision == "f64")
-      o->params.precision = Precision::f64;
-    else if (o->precision != "f32")
-      throw UsageError("--precision: expected f32 or f64, got \"" + o->precision + "\"");
+    o->params.precision = parse_precision(o->precision);
     const std::vector<Method> methods = parse_methods(o->methods);
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
     if (std::any_of(methods.begin(), methods.end(), [](Method m) { return m != Method::analytic; }))
@@ -126,11 +123,7 @@ void add_conform(CLI::App& app) {
                   "method", "ambig%", "hit%", "cross%", "img%", "stepKS", "traces", "failures",
                   "verdict");
     for (const std::string& name : o->backends) {
-      if (name == "oracle")
-        throw UsageError("--backend: the oracle is what the others are measured against");
-      const std::unique_ptr<Backend> backend = make_backend(name, o->backend_options);
-      if (!backend)
-        throw UsageError("--backend: unknown backend \"" + name + "\" (see `flatmarch backends`)");
+      const std::unique_ptr<Backend> backend = make_kernel_backend(name, o->backend_options);
       const Availability a = backend->availability();
       const std::vector<Precision> precisions = backend->precisions();
       std::string skip = a.available ? "" : "unavailable here: " + a.reason;

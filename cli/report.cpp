@@ -176,12 +176,7 @@ void add_report(CLI::App& app) {
     r.matrix.backend_options = o->backend_options;
     r.matrix.methods = parse_methods(o->methods);
     if (!o->backends.empty()) r.matrix.backends = o->backends;
-    for (const std::string& b : r.matrix.backends) {
-      if (b == "oracle")
-        throw UsageError("--backend: the oracle is what the others are measured against");
-      if (!make_backend(b, o->backend_options))
-        throw UsageError("--backend: unknown backend \"" + b + "\" (see `flatmarch backends`)");
-    }
+    for (const std::string& b : r.matrix.backends) make_kernel_backend(b, o->backend_options);
     std::tie(r.matrix.width, r.matrix.height) =
         parse_size("--size", o->size.empty() ? (o->full ? "640x360" : "256x144") : o->size);
     std::tie(r.matrix.conform_width, r.matrix.conform_height) =
@@ -204,9 +199,13 @@ void add_report(CLI::App& app) {
     if (!o->sweep_backend.empty()) r.sweep.backend = o->sweep_backend;
     if (r.sweep_enabled) {
       const std::unique_ptr<Backend> b = make_backend(r.sweep.backend, o->backend_options);
-      if (!b || r.sweep.backend == "oracle")
-        throw UsageError("--sweep-backend: expected scalar, simd, opengl or vulkan, got \"" +
+      const std::vector<std::string> kernel = kernel_backend_names();
+      if (!b || std::find(kernel.begin(), kernel.end(), r.sweep.backend) == kernel.end()) {
+        std::string names;
+        for (const std::string& n : kernel) names += (names.empty() ? "" : ", ") + n;
+        throw UsageError("--sweep-backend: expected one of " + names + ", got \"" +
                          r.sweep.backend + "\"");
+      }
       if (const Availability a = b->availability(); !a.available)
         throw UnavailableError("--sweep-backend: the " + r.sweep.backend +
                                " backend is unavailable here: " + a.reason);
@@ -359,11 +358,7 @@ void add_sweep(CLI::App& app) {
     o->sweep.methods = parse_methods(o->methods);
     if (!o->precisions.empty()) {
       o->sweep.precisions.clear();
-      for (const std::string& p : o->precisions) {
-        if (p != "f32" && p != "f64")
-          throw UsageError("--precision: expected f32 or f64, got \"" + p + "\"");
-        o->sweep.precisions.push_back(p == "f32" ? Precision::f32 : Precision::f64);
-      }
+      for (const std::string& p : o->precisions) o->sweep.precisions.push_back(parse_precision(p));
     }
     for (double e : o->sweep.eps)
       if (!(e > 0.0 && e < 1.0)) throw UsageError("--eps: values must lie in (0, 1)");
