@@ -79,28 +79,53 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
                      (fallback != default_name ? " where available, else " + fallback : ""));
   app.add_option("--method", method,
                  "Method: " + method_names() + " (default: the backend's first)");
-  app.add_option("--eps", params.eps, "Hit threshold")->capture_default_str();
-  app.add_option("--offset", params.offset, "Re-entry push after a gluing")->capture_default_str();
-  app.add_option("--max-steps", params.max_steps, "Kernel iterations before a ray gives up")
-      ->capture_default_str();
-  app.add_option("--max-distance", params.max_distance, "Path length before a ray gives up")
-      ->capture_default_str();
-  app.add_option("--omega", params.omega, "Over-relaxation factor of the relaxed method")
-      ->capture_default_str();
+  add_march_param_options(app, params);
   app.add_option("--precision", precision, "f32 or f64 (f64 on the oracle and scalar backends)")
       ->capture_default_str();
-  app.add_option("--isa", backend_options.isa,
+  add_backend_options(app, backend_options);
+}
+
+void add_march_param_options(CLI::App& app, MarchParams& params, MarchParamOptions which) {
+  if (which.eps) app.add_option("--eps", params.eps, "Hit threshold, > 0")->capture_default_str();
+  if (which.offset)
+    app.add_option("--offset", params.offset, "Re-entry push after a gluing, > 0")
+        ->capture_default_str();
+  if (which.max_steps)
+    app.add_option("--max-steps", params.max_steps,
+                   "Kernel iterations before a ray gives up, in [1, 1e8]")
+        ->capture_default_str();
+  if (which.max_distance)
+    app.add_option("--max-distance", params.max_distance, "Path length before a ray gives up, > 0")
+        ->capture_default_str();
+  if (which.omega)
+    app.add_option("--omega", params.omega,
+                   "Over-relaxation factor of the relaxed method, in [1, 2)")
+        ->capture_default_str();
+}
+
+void add_backend_options(CLI::App& app, BackendOptions& options) {
+  app.add_option("--isa", options.isa,
                  "simd: the instruction set, one of those `flatmarch backends` lists (default: "
                  "the best this CPU runs)");
-  app.add_option("--threads", backend_options.threads, "simd: worker threads (0: all cores)")
+  app.add_option("--threads", options.threads, "simd: worker threads (0: all cores)")
       ->capture_default_str();
-  app.add_option("--device", backend_options.device,
+  app.add_option("--device", options.device,
                  "opengl, vulkan: the device, by its index or a part of its name as `flatmarch "
                  "backends` lists them (default: a GPU, else the CPU: llvmpipe through EGL, then "
                  "OSMesa; lavapipe)");
-  app.add_flag("--vk-staging", backend_options.vk_staging,
+  app.add_flag("--vk-staging", options.vk_staging,
                "vulkan: read frames back through a staging buffer, as on a discrete GPU, even "
                "where the device's memory is host-visible");
+}
+
+void check_backend_options(const BackendOptions& options) {
+  if (options.threads < 0) throw UsageError("--threads: must be 0 (all cores) or more");
+  const std::vector<std::string> isas = simd::isa_names(false);
+  if (!options.isa.empty() && std::find(isas.begin(), isas.end(), options.isa) == isas.end()) {
+    std::string list;
+    for (const std::string& name : isas) list += (list.empty() ? "" : ", ") + name;
+    throw UsageError("--isa: unknown instruction set \"" + options.isa + "\" (" + list + ")");
+  }
 }
 
 Precision parse_precision(const std::string& text) {
@@ -152,15 +177,7 @@ const Backend& MarchOptions::resolve() {
     const Backend* preferred = find_backend(default_backend);
     backend = preferred && preferred->availability().available ? default_backend : fallback_;
   }
-  if (backend_options.threads < 0) throw UsageError("--threads: must be 0 (all cores) or more");
-  const std::vector<std::string> isas = simd::isa_names(false);
-  if (!backend_options.isa.empty() &&
-      std::find(isas.begin(), isas.end(), backend_options.isa) == isas.end()) {
-    std::string list;
-    for (const std::string& name : isas) list += (list.empty() ? "" : ", ") + name;
-    throw UsageError("--isa: unknown instruction set \"" + backend_options.isa + "\" (" + list +
-                     ")");
-  }
+  check_backend_options(backend_options);
   made_ = make_backend(backend, backend_options);
   if (!made_)
     throw UsageError("--backend: unknown backend \"" + backend + "\" (see `flatmarch backends`)");
@@ -251,12 +268,19 @@ std::vector<Scene> load_scenes(const std::vector<std::string>& names,
   return scenes;
 }
 
+std::string kernel_method_names() {
+  std::string names;
+  for (Method m : kKernelMethods) names += (names.empty() ? "" : ", ") + std::string(to_string(m));
+  return names;
+}
+
 std::vector<Method> parse_methods(const std::vector<std::string>& names) {
   std::vector<Method> methods;
   for (const std::string& name : names) {
     const auto m = parse_method(name);
     if (!m || *m == Method::oracle)
-      throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + name + "\"");
+      throw UsageError("--method: expected one of " + kernel_method_names() + ", got \"" + name +
+                       "\"");
     methods.push_back(*m);
   }
   if (methods.empty()) methods.assign(kKernelMethods.begin(), kKernelMethods.end());

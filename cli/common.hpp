@@ -40,6 +40,9 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
 std::vector<Scene> load_scenes(const std::vector<std::string>& names,
                                const std::vector<std::string>& galleries);
 
+// The kernel's methods, named in order and joined by ", " (help texts and errors).
+std::string kernel_method_names();
+
 // The kernel methods named by --method options (UsageError for another name); all three when
 // none is named.
 std::vector<Method> parse_methods(const std::vector<std::string>& names);
@@ -51,6 +54,19 @@ Precision parse_precision(const std::string& text);
 // backend that does not run the kernel (the oracle, which the others are measured against).
 std::unique_ptr<Backend> make_kernel_backend(const std::string& name,
                                              const BackendOptions& options);
+
+// The march parameters' options (--eps, --offset, --max-steps, --max-distance, --omega), each
+// declared here once with one help text; check_march_params holds each to one range. A command
+// takes those `which` names (all: the five).
+struct MarchParamOptions {
+  bool eps = true, offset = true, max_steps = true, max_distance = true, omega = true;
+};
+void add_march_param_options(CLI::App& app, MarchParams& params, MarchParamOptions which = {});
+
+// The backends' own options (--isa, --threads, --device, --vk-staging), declared once;
+// check_backend_options checks them.
+void add_backend_options(CLI::App& app, BackendOptions& options);
+void check_backend_options(const BackendOptions& options);
 
 // Throws UsageError for parameters out of range; warns (stderr) when offset <= eps.
 void check_march_params(const MarchParams& params);

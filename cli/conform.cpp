@@ -64,8 +64,7 @@ void add_conform(CLI::App& app) {
   cmd->add_option("--scene", o->scenes,
                   "Scene file, or a scene's name in a --gallery folder (repeat; default: every "
                   "scene of the --gallery folders)");
-  cmd->add_option("--method", o->methods,
-                  "sphere, relaxed or analytic (repeat; default: all three)");
+  cmd->add_option("--method", o->methods, kernel_method_names() + " (repeat; default: all)");
   cmd->add_option("--gallery", o->galleries,
                   "Folders of scenes, run whole when no --scene is given and searched for "
                   "--scene names (repeat; default: scenes and conformance/scenes, the suite's own)")
@@ -74,28 +73,15 @@ void add_conform(CLI::App& app) {
   cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
   cmd->add_option("--thresholds", o->thresholds,
                   "Thresholds file (default: conformance/thresholds.json as built in)");
-  cmd->add_option("--eps", o->params.eps, "Hit threshold")->capture_default_str();
-  cmd->add_option("--offset", o->params.offset, "Re-entry push after a gluing")
-      ->capture_default_str();
-  cmd->add_option("--max-steps", o->params.max_steps, "Kernel iterations before a ray gives up")
-      ->capture_default_str();
-  cmd->add_option("--max-distance", o->params.max_distance, "Path length before a ray gives up")
-      ->capture_default_str();
-  cmd->add_option("--omega", o->params.omega, "Over-relaxation factor of the relaxed method")
-      ->capture_default_str();
+  add_march_param_options(*cmd, o->params);
   cmd->add_option("--precision", o->precision, "f32 or f64 (backends without f64 are skipped)")
       ->capture_default_str();
-  cmd->add_option("--isa", o->backend_options.isa, "simd: the instruction set");
-  cmd->add_option("--threads", o->backend_options.threads, "simd: worker threads (0: all cores)");
-  cmd->add_option("--device", o->backend_options.device,
-                  "opengl, vulkan: the device, by its index or a part of its name (see "
-                  "`flatmarch backends`)");
-  cmd->add_flag("--vk-staging", o->backend_options.vk_staging,
-                "vulkan: read frames back through a staging buffer, as on a discrete GPU");
+  add_backend_options(*cmd, o->backend_options);
   cmd->add_flag("-q,--quiet", o->quiet, "Only the summary line");
   cmd->callback([o] {
     const auto [w, h] = parse_size("--size", o->size);
     check_march_params(o->params);
+    check_backend_options(o->backend_options);
     o->params.precision = parse_precision(o->precision);
     const std::vector<Method> methods = parse_methods(o->methods);
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);

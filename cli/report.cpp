@@ -121,7 +121,7 @@ void add_report(CLI::App& app) {
                   "unavailable here skipped with the reason)");
   cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
   cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
-  cmd->add_option("--method", o->methods, "sphere, relaxed or analytic (repeat; default: all)");
+  cmd->add_option("--method", o->methods, kernel_method_names() + " (repeat; default: all)");
   cmd->add_option("--size", o->size, "Timed frames WxH (default 256x144; --full 640x360)");
   cmd->add_option("--conform-size", o->conform_size, "Frames measured against the oracle")
       ->capture_default_str();
@@ -142,18 +142,10 @@ void add_report(CLI::App& app) {
                   "Write this run's deterministic figures as a baseline file");
   cmd->add_option("--python", o->python, "python3 with matplotlib (env FLATMARCH_PYTHON)")
       ->capture_default_str();
-  cmd->add_option("--eps", o->params.eps, "Hit threshold of the matrix")->capture_default_str();
-  cmd->add_option("--offset", o->params.offset, "Re-entry push of the matrix")
-      ->capture_default_str();
-  cmd->add_option("--max-steps", o->params.max_steps, "Kernel iterations before a ray gives up")
-      ->capture_default_str();
-  cmd->add_option("--isa", o->backend_options.isa, "simd: the instruction set");
-  cmd->add_option("--threads", o->backend_options.threads, "simd: worker threads (0: all cores)");
-  cmd->add_option("--device", o->backend_options.device,
-                  "opengl, vulkan: the device, by its index or a part of its name (see "
-                  "`flatmarch backends`)");
-  cmd->add_flag("--vk-staging", o->backend_options.vk_staging,
-                "vulkan: read frames back through a staging buffer, as on a discrete GPU");
+  add_march_param_options(
+      *cmd, o->params,
+      {.eps = true, .offset = true, .max_steps = true, .max_distance = false, .omega = false});
+  add_backend_options(*cmd, o->backend_options);
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
     if (!o->results.empty()) {
@@ -171,6 +163,7 @@ void add_report(CLI::App& app) {
       return;
     }
     check_march_params(o->params);
+    check_backend_options(o->backend_options);
     reports::ReportOptions r;
     r.matrix.params = o->params;
     r.matrix.backend_options = o->backend_options;
@@ -334,7 +327,7 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
   cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
   cmd->add_option("--backend", o->sweep.backend, "Backend to sweep")->capture_default_str();
-  cmd->add_option("--method", o->methods, "sphere, relaxed or analytic (repeat; default: all)");
+  cmd->add_option("--method", o->methods, kernel_method_names() + " (repeat; default: all)");
   cmd->add_option("--precision", o->precisions, "f32 or f64 (repeat; default: those it has)");
   cmd->add_option("--eps", o->sweep.eps, "The eps values")->capture_default_str();
   cmd->add_option("--offset-factor", o->sweep.offset_factors, "Offsets as multiples of eps")
@@ -343,14 +336,10 @@ void add_sweep(CLI::App& app) {
   cmd->add_option("--size", o->size, "Frame size WxH")->capture_default_str();
   cmd->add_option("--repetitions", o->sweep.repetitions, "Frames timed per point (median)")
       ->capture_default_str();
-  cmd->add_option("--max-steps", o->sweep.params.max_steps, "Kernel iterations")
-      ->capture_default_str();
-  cmd->add_option("--isa", o->sweep.backend_options.isa, "simd: the instruction set");
-  cmd->add_option("--device", o->sweep.backend_options.device,
-                  "opengl, vulkan: the device, by its index or a part of its name (see "
-                  "`flatmarch backends`)");
-  cmd->add_flag("--vk-staging", o->sweep.backend_options.vk_staging,
-                "vulkan: read frames back through a staging buffer, as on a discrete GPU");
+  add_march_param_options(
+      *cmd, o->sweep.params,
+      {.eps = false, .offset = false, .max_steps = true, .max_distance = false, .omega = false});
+  add_backend_options(*cmd, o->sweep.backend_options);
   cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
@@ -368,8 +357,8 @@ void add_sweep(CLI::App& app) {
       if (!(f > 0.0 && f < 1.0)) throw UsageError("--offset-fixed: values must lie in (0, 1)");
     if (o->sweep.repetitions < 1 || o->sweep.repetitions > 100)
       throw UsageError("--repetitions: expected 1 to 100");
-    if (o->sweep.params.max_steps < 1 || o->sweep.params.max_steps > (1 << 20))
-      throw UsageError("--max-steps: expected 1 to 1048576");
+    check_march_params(o->sweep.params);
+    check_backend_options(o->sweep.backend_options);
     const std::unique_ptr<Backend> backend =
         make_backend(o->sweep.backend, o->sweep.backend_options);
     if (!backend || o->sweep.backend == "oracle")

@@ -41,13 +41,17 @@ void add_view(CLI::App& app) {
   cmd->add_option("--scale", o->scale,
                   "Rendered resolution as a fraction of the window's, in (0, 1]; keys - and =")
       ->capture_default_str();
-  cmd->add_option("--method", o->method, "Method: sphere, relaxed or analytic; keys 1, 2, 3")
+  cmd->add_option("--method", o->method, "Method: " + kernel_method_names() + "; keys 1, 2, 3")
       ->capture_default_str();
-  cmd->add_option("--eps", o->params.eps, "Hit threshold; keys [ and ]")->capture_default_str();
-  cmd->add_option("--offset", o->params.offset, "Re-entry push after a gluing, above eps; keys ; '")
-      ->capture_default_str();
-  cmd->add_option("--max-steps", o->params.max_steps, "Kernel iterations before a ray gives up")
-      ->capture_default_str();
+  add_march_param_options(
+      *cmd, o->params,
+      {.eps = true, .offset = true, .max_steps = true, .max_distance = false, .omega = false});
+  for (const auto& [name, keys] :
+       {std::pair{"--eps", "; here within [1e-7, 1e-2], keys [ and ]"},
+        std::pair{"--offset", ", above eps and at most 0.5 here; keys ; and '"}}) {
+    CLI::Option* option = cmd->get_option(name);
+    option->description(option->get_description() + keys);
+  }
   cmd->add_option("--screenshot-dir", o->screenshot_dir,
                   "Folder of F12's flatmarch-screenshot-N.png")
       ->capture_default_str();
@@ -61,16 +65,17 @@ void add_view(CLI::App& app) {
     if (!(o->scale > 0.0 && o->scale <= 1.0)) throw UsageError("--scale: must lie in (0, 1]");
     const auto method = parse_method(o->method);
     if (!method || *method == Method::oracle)
-      throw UsageError("--method: expected sphere, relaxed or analytic, got \"" + o->method + "\"");
+      throw UsageError("--method: expected one of " + kernel_method_names() + ", got \"" +
+                       o->method + "\"");
     o->params.method = *method;
+    check_march_params(o->params);
+    // The keys step eps and offset within these bounds, so the viewer starts within them.
     if (!(o->params.eps >= viewer::kMinEps && o->params.eps <= viewer::kMaxEps))
       throw UsageError("--eps: must lie in [1e-7, 1e-2]");
     if (!(o->params.offset > o->params.eps && o->params.offset <= viewer::kMaxOffset))
       throw UsageError(
           "--offset: must lie above --eps (a ray placed no further than eps from the edge it "
           "came through crosses back) and at most 0.5");
-    if (o->params.max_steps < 1 || o->params.max_steps > 1'000'000)
-      throw UsageError("--max-steps: must lie in [1, 1e6]");
     if (o->frames < 0) throw UsageError("--frames: must be 0 or more");
     if (!std::filesystem::is_directory(o->screenshot_dir))
       throw UsageError("--screenshot-dir: " + o->screenshot_dir + " is not a folder");

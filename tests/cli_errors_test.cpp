@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "scene/load.hpp"
 #include "tests/process.hpp"
@@ -249,9 +251,9 @@ TEST(HostileInput, TooManyPolygonsIsAnError) {
 
 // Bad arguments: exit 2 and one `error:` line naming the option.
 struct ArgCase {
-  const char* name;
+  std::string name;
   std::vector<std::string> args;
-  const char* fragment;
+  std::string fragment;
 };
 
 void PrintTo(const ArgCase& c, std::ostream* os) {
@@ -335,6 +337,39 @@ INSTANTIATE_TEST_SUITE_P(
                 {"gallery", "@SCENES@/torus.json", "-o", "@OUT@"},
                 "not a folder"}),
     [](const testing::TestParamInfo<ArgCase>& p) { return std::string(p.param.name); });
+
+// The march parameters and backend options are declared once (cli/common.cpp) and held to one
+// range each: every command that takes one rejects the same values with the same words.
+std::vector<ArgCase> shared_option_cases() {
+  const std::vector<std::pair<std::string, std::vector<std::string>>> commands{
+      {"render", {"render", "@SCENES@/torus.json", "-o", "@OUT@/x.png"}},
+      {"conform", {"conform", "--scene", "torus", "--json", "@OUT@/x.json"}},
+      {"report", {"report", "--out", "@OUT@"}},
+      {"sweep", {"sweep", "--scene", "torus", "--json", "@OUT@/x.json"}},
+      {"view", {"view", "@SCENES@/torus.json", "--frames", "1"}}};
+  const std::vector<std::tuple<std::string, std::vector<std::string>, std::string>> options{
+      {"max_steps_zero", {"--max-steps", "0"}, "--max-steps: must lie in [1, 1e8]"},
+      {"max_steps_huge", {"--max-steps", "200000000"}, "--max-steps: must lie in [1, 1e8]"},
+      {"isa_unknown", {"--isa", "avx9000"}, "--isa: unknown instruction set \"avx9000\""},
+      {"threads_negative", {"--threads", "-1"}, "--threads: must be 0 (all cores) or more"}};
+  std::vector<ArgCase> cases;
+  for (const auto& [command, args] : commands)
+    for (const auto& [name, option, fragment] : options) {
+      if (command == "view" && option[0] != "--max-steps") continue;  // no backend options
+      std::vector<std::string> all = args;
+      all.insert(all.end(), option.begin(), option.end());
+      cases.push_back({command + "_" + name, all, fragment});
+    }
+  for (const size_t k : {1u, 3u}) {  // conform and sweep parse --precision themselves
+    std::vector<std::string> all = commands[k].second;
+    all.insert(all.end(), {"--precision", "f16"});
+    cases.push_back({commands[k].first + "_precision", all, "--precision: expected f32 or f64"});
+  }
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedOptions, BadArguments, testing::ValuesIn(shared_option_cases()),
+                         [](const testing::TestParamInfo<ArgCase>& p) { return p.param.name; });
 
 TEST(Cli, EverySubcommandHasHelp) {
   for (const char* command : {"inspect", "render", "trace", "backends", "gallery", "import-peer",
