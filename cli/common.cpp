@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 
@@ -309,6 +310,23 @@ void ProgressReporter::operator()(double fraction) {
 void ProgressReporter::done() {
   if (!quiet_ && tty_ && last_ >= 0.0)
     std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 30, "");
+}
+
+nlohmann::json read_json(const std::string& option, const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw UsageError(option + ": cannot read " + file.string());
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw UsageError(option + ": " + file.string() + " is not JSON: " + e.what());
+  }
+}
+
+void write_json(const std::filesystem::path& file, const nlohmann::json& doc) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream out(file);
+  out << doc.dump(1) << "\n";
+  if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 
 }  // namespace flatmarch::cli

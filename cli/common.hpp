@@ -1,6 +1,7 @@
 // What the subcommands share: errors with their exit codes, march options, argument parsing.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "backends/backend.hpp"
 
@@ -46,6 +48,11 @@ std::string kernel_method_names();
 // The kernel methods named by --method options (UsageError for another name); all three when
 // none is named.
 std::vector<Method> parse_methods(const std::vector<std::string>& names);
+
+// A JSON file named by `option` (UsageError if it cannot be read or is not JSON), and writing
+// one (its folder made; runtime_error if it cannot be written).
+nlohmann::json read_json(const std::string& option, const std::filesystem::path& file);
+void write_json(const std::filesystem::path& file, const nlohmann::json& doc);
 
 // The precision --precision names: f32 or f64 (UsageError for another).
 Precision parse_precision(const std::string& text);

@@ -20,23 +20,6 @@ using nlohmann::json;
 
 namespace {
 
-json read_json(const std::string& option, const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw UsageError(option + ": cannot read " + file.string());
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw UsageError(option + ": " + file.string() + " is not JSON: " + e.what());
-  }
-}
-
-void write_json(const fs::path& file, const json& doc) {
-  if (file.has_parent_path()) fs::create_directories(file.parent_path());
-  std::ofstream out(file);
-  out << doc.dump(1) << "\n";
-  if (!out) throw std::runtime_error("cannot write " + file.string());
-}
-
 // A word for the shell, quoted.
 std::string quoted(const std::string& word) {
   std::string q = "'";
@@ -249,163 +232,11 @@ void add_report(CLI::App& app) {
                            results["options"][key].dump() + "; measure alike");
       const json check = reports::check_baseline(baseline, results);
       write_json(fs::path(o->out) / "gate.json", check);
-      for (const json& w : check["timing_warnings"])
-        std::printf("warning: %s is slower: %.3g ms against %.3g ms (x%.2f, Mann-Whitney p=%.3g)\n",
-                    w["case"].get<std::string>().c_str(), w["now_ms"].get<double>(),
-                    w["was_ms"].get<double>(), w["ratio"].get<double>(),
-                    w["p_value"].get<double>());
-      if (!check["same_machine"].get<bool>() && !check["timing_warnings"].empty())
-        std::printf(
-            "warning: the baseline's timings come from another CPU (%s): compare with "
-            "care\n",
-            reports::describe_machine(baseline["fingerprint"]).c_str());
-      for (const json& m : check["missing"])
-        std::printf("warning: %s is in the baseline but was not measured\n",
-                    m.get<std::string>().c_str());
-      for (const json& i : check["improvements"])
-        std::printf("improved: %s %s %s -> %s (update the baseline: --write-baseline)\n",
-                    i["case"].get<std::string>().c_str(), i["figure"].get<std::string>().c_str(),
-                    i["was"].dump().c_str(), i["now"].dump().c_str());
-      for (const json& g : check["regressions"])
-        std::printf("REGRESSION: %s %s %s -> %s (tolerance %s)\n",
-                    g["case"].get<std::string>().c_str(), g["figure"].get<std::string>().c_str(),
-                    g["was"].dump().c_str(), g["now"].dump().c_str(),
-                    g.value("tolerance", json(0)).dump().c_str());
-      std::printf(
-          "gate: %d cases compared with %s: %zu regressions, %zu improvements, %zu timing "
-          "warnings, %zu missing\n",
-          check["compared"].get<int>(), o->baseline.c_str(), check["regressions"].size(),
-          check["improvements"].size(), check["timing_warnings"].size(), check["missing"].size());
+      std::printf("%s", reports::describe_gate(check, baseline, o->baseline).c_str());
       if (!check["regressions"].empty())
         throw ConformanceFailure(std::to_string(check["regressions"].size()) +
                                  " figures regressed against " + o->baseline);
     }
-  });
-}
-
-void add_select(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "select",
-      "Print the backend, method and parameters `flatmarch report` chose for this machine, from\n"
-      "its results file: the fastest backend of those that passed every conformance case, its\n"
-      "fastest conforming method, and eps and offset per surface type from the sweep.");
-  struct Options {
-    std::string results = "reports/out/results.json", scene;
-  };
-  auto o = std::make_shared<Options>();
-  cmd->add_option("RESULTS", o->results, "A results file of `flatmarch report`")
-      ->capture_default_str();
-  cmd->add_option("--scene", o->scene,
-                  "A scene file: print only the parameters for its surface type");
-  cmd->callback([o] {
-    if (!fs::exists(o->results))
-      throw UsageError("RESULTS: no " + o->results + "; run `flatmarch report` first");
-    const json results = read_json("RESULTS", o->results);
-    if (!results.contains("recommendation") || !results.contains("fingerprint"))
-      throw UsageError("RESULTS: " + o->results + " is not a results file of `flatmarch report`");
-    const std::string type = o->scene.empty() ? "" : reports::surface_type(load_scene(o->scene));
-    std::printf("%s", reports::describe_selection(results, type).c_str());
-  });
-}
-
-void add_sweep(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "sweep",
-      "March each scene over a grid of eps (1e-1 ... 1e-7) and offsets (0.5 ... 10 x eps, and\n"
-      "fixed values) for each method and precision, measuring time, steps and accuracy against\n"
-      "the oracle (conformance verdict, hit mismatch, trace agreement, failures by class). Per\n"
-      "surface type it prints the stable region (every scene passes), the speed-accuracy Pareto\n"
-      "front and the recommended eps and offset; writes everything as JSON.");
-  struct Options {
-    std::vector<std::string> scenes, methods, precisions;
-    std::vector<std::string> galleries = {"scenes"};
-    std::string size = "64x36", json = "sweep.json";
-    reports::SweepOptions sweep;
-    bool quiet = false;
-  };
-  auto o = std::make_shared<Options>();
-  cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
-  cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
-  cmd->add_option("--backend", o->sweep.backend, "Backend to sweep")->capture_default_str();
-  cmd->add_option("--method", o->methods, kernel_method_names() + " (repeat; default: all)");
-  cmd->add_option("--precision", o->precisions, "f32 or f64 (repeat; default: those it has)");
-  cmd->add_option("--eps", o->sweep.eps, "The eps values")->capture_default_str();
-  cmd->add_option("--offset-factor", o->sweep.offset_factors, "Offsets as multiples of eps")
-      ->capture_default_str();
-  cmd->add_option("--offset-fixed", o->sweep.offset_fixed, "Fixed offsets")->capture_default_str();
-  cmd->add_option("--size", o->size, "Frame size WxH")->capture_default_str();
-  cmd->add_option("--repetitions", o->sweep.repetitions, "Frames timed per point (median)")
-      ->capture_default_str();
-  add_march_param_options(
-      *cmd, o->sweep.params,
-      {.eps = false, .offset = false, .max_steps = true, .max_distance = false, .omega = false});
-  add_backend_options(*cmd, o->sweep.backend_options);
-  cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
-  cmd->add_flag("-q,--quiet", o->quiet, "No progress");
-  cmd->callback([o] {
-    std::tie(o->sweep.width, o->sweep.height) = parse_size("--size", o->size);
-    o->sweep.methods = parse_methods(o->methods);
-    if (!o->precisions.empty()) {
-      o->sweep.precisions.clear();
-      for (const std::string& p : o->precisions) o->sweep.precisions.push_back(parse_precision(p));
-    }
-    for (double e : o->sweep.eps)
-      if (!(e > 0.0 && e < 1.0)) throw UsageError("--eps: values must lie in (0, 1)");
-    for (double f : o->sweep.offset_factors)
-      if (!(f > 0.0 && f <= 1000.0)) throw UsageError("--offset-factor: values in (0, 1000]");
-    for (double f : o->sweep.offset_fixed)
-      if (!(f > 0.0 && f < 1.0)) throw UsageError("--offset-fixed: values must lie in (0, 1)");
-    if (o->sweep.repetitions < 1 || o->sweep.repetitions > 100)
-      throw UsageError("--repetitions: expected 1 to 100");
-    check_march_params(o->sweep.params);
-    check_backend_options(o->sweep.backend_options);
-    const std::unique_ptr<Backend> backend =
-        make_backend(o->sweep.backend, o->sweep.backend_options);
-    if (!backend || o->sweep.backend == "oracle")
-      throw UsageError("--backend: expected scalar, simd, opengl or vulkan, got \"" +
-                       o->sweep.backend + "\"");
-    if (const Availability a = backend->availability(); !a.available)
-      throw UnavailableError("the " + o->sweep.backend +
-                             " backend is unavailable here: " + a.reason);
-    const std::vector<Precision> has = backend->precisions();
-    if (std::none_of(o->sweep.precisions.begin(), o->sweep.precisions.end(), [&](Precision p) {
-          return std::find(has.begin(), has.end(), p) != has.end();
-        }))
-      throw UsageError("--precision: the " + o->sweep.backend + " backend marches in f32 only");
-    const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
-    conformance::Suite suite;
-    ProgressReporter progress("sweep", o->quiet);
-    json result =
-        reports::run_sweep(scenes, o->sweep, suite, [&](const std::string&, int done, int total) {
-          progress(static_cast<double>(done) / total);
-        });
-    progress.done();
-    result["fingerprint"] = reports::hardware_fingerprint();
-    write_json(o->json, result);
-    std::printf("%-12s %-9s %-4s %7s  %-26s %s\n", "surface", "method", "prec", "stable",
-                "recommended eps / offset", "pareto front (eps, offset: ms, hit mismatch %)");
-    for (const json& g : result["analysis"]) {
-      std::string rec = "-";
-      if (!g["recommended"].is_null()) {
-        char s[64];
-        std::snprintf(s, sizeof s, "%g / %g", g["recommended"]["eps"].get<double>(),
-                      g["recommended"]["offset"].get<double>());
-        rec = s;
-      }
-      std::string front;
-      for (const json& p : g["pareto"]) {
-        char s[96];
-        std::snprintf(s, sizeof s, "%s%g,%s: %.2g, %.2g", front.empty() ? "" : "; ",
-                      p["eps"].get<double>(), p["offset_label"].get<std::string>().c_str(),
-                      p["time_ms"].get<double>(), 100.0 * p["hit_mismatch"].get<double>());
-        front += s;
-      }
-      std::printf("%-12s %-9s %-4s %3zu/%-3zu  %-26s %s\n",
-                  g["surface_type"].get<std::string>().c_str(),
-                  g["method"].get<std::string>().c_str(), g["precision"].get<std::string>().c_str(),
-                  g["stable"].size(), g["grid"].size(), rec.c_str(), front.c_str());
-    }
-    std::printf("wrote %s\n", o->json.c_str());
   });
 }
 

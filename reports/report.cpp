@@ -387,4 +387,48 @@ json check_baseline(const json& baseline, const json& results) {
   return out;
 }
 
+namespace {
+// printf into a string.
+template <typename... Args>
+std::string format(const char* pattern, Args... args) {
+  const int n = std::snprintf(nullptr, 0, pattern, args...);
+  std::string s(static_cast<size_t>(std::max(n, 0)) + 1, '\0');
+  std::snprintf(s.data(), s.size(), pattern, args...);
+  s.resize(static_cast<size_t>(std::max(n, 0)));
+  return s;
+}
+}  // namespace
+
+std::string describe_gate(const json& check, const json& baseline,
+                          const std::string& baseline_file) {
+  std::string out;
+  for (const json& w : check["timing_warnings"])
+    out += format("warning: %s is slower: %.3g ms against %.3g ms (x%.2f, Mann-Whitney p=%.3g)\n",
+                  w["case"].get<std::string>().c_str(), w["now_ms"].get<double>(),
+                  w["was_ms"].get<double>(), w["ratio"].get<double>(), w["p_value"].get<double>());
+  if (!check["same_machine"].get<bool>() && !check["timing_warnings"].empty())
+    out += format(
+        "warning: the baseline's timings come from another CPU (%s): compare with "
+        "care\n",
+        reports::describe_machine(baseline["fingerprint"]).c_str());
+  for (const json& m : check["missing"])
+    out += format("warning: %s is in the baseline but was not measured\n",
+                  m.get<std::string>().c_str());
+  for (const json& i : check["improvements"])
+    out += format("improved: %s %s %s -> %s (update the baseline: --write-baseline)\n",
+                  i["case"].get<std::string>().c_str(), i["figure"].get<std::string>().c_str(),
+                  i["was"].dump().c_str(), i["now"].dump().c_str());
+  for (const json& g : check["regressions"])
+    out +=
+        format("REGRESSION: %s %s %s -> %s (tolerance %s)\n", g["case"].get<std::string>().c_str(),
+               g["figure"].get<std::string>().c_str(), g["was"].dump().c_str(),
+               g["now"].dump().c_str(), g.value("tolerance", json(0)).dump().c_str());
+  out += format(
+      "gate: %d cases compared with %s: %zu regressions, %zu improvements, %zu timing "
+      "warnings, %zu missing\n",
+      check["compared"].get<int>(), baseline_file.c_str(), check["regressions"].size(),
+      check["improvements"].size(), check["timing_warnings"].size(), check["missing"].size());
+  return out;
+}
+
 }  // namespace flatmarch::reports

@@ -57,6 +57,11 @@ nlohmann::json make_baseline(const nlohmann::json& results);
 // median ratio above 1.1).
 nlohmann::json check_baseline(const nlohmann::json& baseline, const nlohmann::json& results);
 
+// check_baseline's findings as the gate prints them, a line each (warnings, improvements,
+// regressions) and a summary line; baseline_file names the baseline.
+std::string describe_gate(const nlohmann::json& check, const nlohmann::json& baseline,
+                          const std::string& baseline_file);
+
 // The two-sided p-value of the Mann-Whitney U test that samples a and b come from one
 // distribution (normal approximation with tie correction, as scipy's mannwhitneyu without
 // continuity correction); 1 when either has fewer than two samples.

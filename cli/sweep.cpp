@@ -1,0 +1,114 @@
+// `flatmarch sweep`: each scene over a grid of eps and offsets, measured against the oracle, and
+// the stable region, Pareto front and recommendation per surface type.
+#include <algorithm>
+#include <cstdio>
+
+#include "cli/commands.hpp"
+#include "cli/common.hpp"
+#include "conformance/suite.hpp"
+#include "reports/fingerprint.hpp"
+#include "reports/sweep.hpp"
+
+namespace flatmarch::cli {
+
+using nlohmann::json;
+
+void add_sweep(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "sweep",
+      "March each scene over a grid of eps (1e-1 ... 1e-7) and offsets (0.5 ... 10 x eps, and\n"
+      "fixed values) for each method and precision, measuring time, steps and accuracy against\n"
+      "the oracle (conformance verdict, hit mismatch, trace agreement, failures by class). Per\n"
+      "surface type it prints the stable region (every scene passes), the speed-accuracy Pareto\n"
+      "front and the recommended eps and offset; writes everything as JSON.");
+  struct Options {
+    std::vector<std::string> scenes, methods, precisions;
+    std::vector<std::string> galleries = {"scenes"};
+    std::string size = "64x36", json = "sweep.json";
+    reports::SweepOptions sweep;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
+  cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
+  cmd->add_option("--backend", o->sweep.backend, "Backend to sweep")->capture_default_str();
+  cmd->add_option("--method", o->methods, kernel_method_names() + " (repeat; default: all)");
+  cmd->add_option("--precision", o->precisions, "f32 or f64 (repeat; default: those it has)");
+  cmd->add_option("--eps", o->sweep.eps, "The eps values")->capture_default_str();
+  cmd->add_option("--offset-factor", o->sweep.offset_factors, "Offsets as multiples of eps")
+      ->capture_default_str();
+  cmd->add_option("--offset-fixed", o->sweep.offset_fixed, "Fixed offsets")->capture_default_str();
+  cmd->add_option("--size", o->size, "Frame size WxH")->capture_default_str();
+  cmd->add_option("--repetitions", o->sweep.repetitions, "Frames timed per point (median)")
+      ->capture_default_str();
+  add_march_param_options(
+      *cmd, o->sweep.params,
+      {.eps = false, .offset = false, .max_steps = true, .max_distance = false, .omega = false});
+  add_backend_options(*cmd, o->sweep.backend_options);
+  cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress");
+  cmd->callback([o] {
+    std::tie(o->sweep.width, o->sweep.height) = parse_size("--size", o->size);
+    o->sweep.methods = parse_methods(o->methods);
+    if (!o->precisions.empty()) {
+      o->sweep.precisions.clear();
+      for (const std::string& p : o->precisions) o->sweep.precisions.push_back(parse_precision(p));
+    }
+    for (double e : o->sweep.eps)
+      if (!(e > 0.0 && e < 1.0)) throw UsageError("--eps: values must lie in (0, 1)");
+    for (double f : o->sweep.offset_factors)
+      if (!(f > 0.0 && f <= 1000.0)) throw UsageError("--offset-factor: values in (0, 1000]");
+    for (double f : o->sweep.offset_fixed)
+      if (!(f > 0.0 && f < 1.0)) throw UsageError("--offset-fixed: values must lie in (0, 1)");
+    if (o->sweep.repetitions < 1 || o->sweep.repetitions > 100)
+      throw UsageError("--repetitions: expected 1 to 100");
+    check_march_params(o->sweep.params);
+    check_backend_options(o->sweep.backend_options);
+    const std::unique_ptr<Backend> backend =
+        make_kernel_backend(o->sweep.backend, o->sweep.backend_options);
+    if (const Availability a = backend->availability(); !a.available)
+      throw UnavailableError("the " + o->sweep.backend +
+                             " backend is unavailable here: " + a.reason);
+    const std::vector<Precision> has = backend->precisions();
+    if (std::none_of(o->sweep.precisions.begin(), o->sweep.precisions.end(), [&](Precision p) {
+          return std::find(has.begin(), has.end(), p) != has.end();
+        }))
+      throw UsageError("--precision: the " + o->sweep.backend + " backend marches in f32 only");
+    const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
+    conformance::Suite suite;
+    ProgressReporter progress("sweep", o->quiet);
+    json result =
+        reports::run_sweep(scenes, o->sweep, suite, [&](const std::string&, int done, int total) {
+          progress(static_cast<double>(done) / total);
+        });
+    progress.done();
+    result["fingerprint"] = reports::hardware_fingerprint();
+    write_json(o->json, result);
+    std::printf("%-12s %-9s %-4s %7s  %-26s %s\n", "surface", "method", "prec", "stable",
+                "recommended eps / offset", "pareto front (eps, offset: ms, hit mismatch %)");
+    for (const json& g : result["analysis"]) {
+      std::string rec = "-";
+      if (!g["recommended"].is_null()) {
+        char s[64];
+        std::snprintf(s, sizeof s, "%g / %g", g["recommended"]["eps"].get<double>(),
+                      g["recommended"]["offset"].get<double>());
+        rec = s;
+      }
+      std::string front;
+      for (const json& p : g["pareto"]) {
+        char s[96];
+        std::snprintf(s, sizeof s, "%s%g,%s: %.2g, %.2g", front.empty() ? "" : "; ",
+                      p["eps"].get<double>(), p["offset_label"].get<std::string>().c_str(),
+                      p["time_ms"].get<double>(), 100.0 * p["hit_mismatch"].get<double>());
+        front += s;
+      }
+      std::printf("%-12s %-9s %-4s %3zu/%-3zu  %-26s %s\n",
+                  g["surface_type"].get<std::string>().c_str(),
+                  g["method"].get<std::string>().c_str(), g["precision"].get<std::string>().c_str(),
+                  g["stable"].size(), g["grid"].size(), rec.c_str(), front.c_str());
+    }
+    std::printf("wrote %s\n", o->json.c_str());
+  });
+}
+
+}  // namespace flatmarch::cli
