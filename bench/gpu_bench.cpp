@@ -24,7 +24,7 @@
 #include "backends/vulkan/vulkan.hpp"
 #include "bench/gallery.hpp"
 #include "bench/peer_app.hpp"
-#include "scene/peer_import.hpp"
+#include "interop/peer_import.hpp"
 
 namespace flatmarch::bench {
 

@@ -37,7 +37,7 @@ run_ctest() {  # run_ctest BUILD_DIR [ctest arguments...]: keeps ctest's closing
 
 run_fuzzers() {
   local dir=build-fuzz corpus rc=0
-  for fuzzer in "$dir"/fuzz/*_fuzzer; do
+  for fuzzer in "$dir"/*/*_fuzzer; do
     corpus=$(mktemp -d)
     for seed in scenes/*.json tests/data/*/*.json; do cp "$seed" "$corpus/$(basename "$(dirname "$seed")")-$(basename "$seed")"; done
     echo "-- $(basename "$fuzzer") for ${fuzz_seconds}s"

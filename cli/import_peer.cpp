@@ -4,7 +4,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
-#include "scene/peer_import.hpp"
+#include "interop/peer_import.hpp"
 
 namespace flatmarch::cli {
 

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/load.hpp"
-#include "scene/peer_import.hpp"
+#include "interop/peer_import.hpp"
 #include "tests/process.hpp"
 
 namespace flatmarch {

@@ -4,7 +4,7 @@
 #include <string_view>
 
 #include "scene/load.hpp"
-#include "scene/peer_import.hpp"
+#include "interop/peer_import.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

@@ -1,4 +1,4 @@
-#include "scene/peer_import.hpp"
+#include "interop/peer_import.hpp"
 
 #include <algorithm>
 #include <array>
