@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "backends/lru_cache.hpp"
 #include "backends/opengl/gl_api.hpp"
 #include "backends/opengl/gl_kernel.hpp"
 #include "kernels/camera.hpp"
@@ -196,12 +197,15 @@ class Viewer {
   GLuint present_ = 0, inset_program_ = 0, empty_vertex_array_ = 0, inset_vertex_array_ = 0,
          inset_buffer_ = 0;
   GLint inset_window_ = -1;
-  struct CachedProgram {
+  // Programs by their scene file and march parameters.
+  struct ProgramKey {
     std::filesystem::path scene_file;
     MarchParams params;
-    std::unique_ptr<gl::KernelProgram> program;
+    bool operator==(const ProgramKey& o) const {
+      return scene_file == o.scene_file && same_params(params, o.params);
+    }
   };
-  std::vector<CachedProgram> programs_;  // least recently used first
+  LruCache<ProgramKey, std::unique_ptr<gl::KernelProgram>> programs_{kMaxPrograms};
   std::unique_ptr<gl::RenderTargets> targets_;
 };
 
@@ -379,20 +383,13 @@ void Viewer::switch_scene(int direction) {
 
 const gl::KernelProgram& Viewer::program() {
   const MarchParams params = settings_.params();
-  auto it = std::find_if(programs_.begin(), programs_.end(), [&](const CachedProgram& p) {
-    return p.scene_file == scene_file_ && same_params(p.params, params);
+  return *programs_.get({scene_file_, params}, [&] {
+    glfw().SetWindowTitle(window_.get(),
+                          ("flatmarch view: " + scene_.name + " | compiling").c_str());
+    compiled_ = true;
+    return std::make_unique<gl::KernelProgram>(gl_, kernel::compile_scene<float>(scene_, params),
+                                               false);
   });
-  if (it != programs_.end()) {
-    std::rotate(it, it + 1, programs_.end());  // now the most recently used
-    return *programs_.back().program;
-  }
-  glfw().SetWindowTitle(window_.get(), ("flatmarch view: " + scene_.name + " | compiling").c_str());
-  auto made =
-      std::make_unique<gl::KernelProgram>(gl_, kernel::compile_scene<float>(scene_, params), false);
-  if (programs_.size() == kMaxPrograms) programs_.erase(programs_.begin());
-  programs_.push_back({scene_file_, params, std::move(made)});
-  compiled_ = true;
-  return *programs_.back().program;
 }
 
 CameraBasis<float> Viewer::basis(int width, int height) const {

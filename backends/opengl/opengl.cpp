@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "backends/bands.hpp"
+#include "backends/lru_cache.hpp"
 #include "backends/opengl/context.hpp"
 #include "backends/opengl/gl_api.hpp"
 #include "backends/opengl/gl_kernel.hpp"
@@ -27,26 +28,16 @@ struct OpenGlBackend::Context {
   std::mutex mutex;  // one frame or trace at a time; the context is current only during one
   std::unique_ptr<gl::RenderTargets> targets;  // the last frame's, kept for the next one
   std::vector<float> aovs;                     // read-back of the AOV target, reused
-  // Programs by their fragment source, least recently used first.
-  std::vector<std::pair<std::string, std::unique_ptr<gl::KernelProgram>>> programs;
+  // Programs by their fragment source.
+  LruCache<std::string, std::unique_ptr<gl::KernelProgram>> programs{kProgramCache};
 
   const gl::Api& gl() const { return gl_context->api(); }
 
   gl::KernelProgram& program(const kernel::SceneTables<float>& tables, bool trace,
                              bool from_band = false) {
-    std::string key = kernel::scene_fragment_shader(tables, trace, from_band);
-    auto it = std::find_if(programs.begin(), programs.end(),
-                           [&](const auto& p) { return p.first == key; });
-    if (it == programs.end()) {
-      if (programs.size() == kProgramCache) programs.erase(programs.begin());
-      programs.emplace_back(std::move(key),
-                            std::make_unique<gl::KernelProgram>(gl(), tables, trace, from_band));
-      it = programs.end() - 1;
-    } else {
-      std::rotate(it, it + 1, programs.end());  // now the most recently used
-      it = programs.end() - 1;
-    }
-    return *it->second;
+    return *programs.get(kernel::scene_fragment_shader(tables, trace, from_band), [&] {
+      return std::make_unique<gl::KernelProgram>(gl(), tables, trace, from_band);
+    });
   }
 
   ~Context() {

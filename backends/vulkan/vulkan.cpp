@@ -20,6 +20,7 @@
 
 #include "backends/bands.hpp"
 #include "backends/kernel_trace.hpp"
+#include "backends/lru_cache.hpp"
 #include "backends/process_exit.hpp"
 #include "backends/vulkan/spirv.hpp"
 #include "kernels/camera.hpp"
@@ -168,13 +169,11 @@ struct VulkanBackend::Context {
   bool read_directly = false;
   bool force_staging = false;  // BackendOptions::vk_staging
   std::mutex mutex;            // one frame or trace at a time
-  // Pipelines by their source, least recently used first.
   struct CachedPipeline {
-    std::string source;
     vk::raii::Pipeline pipeline;
     double pace = 0.0;  // of its last frame (BandPacer::pace)
   };
-  std::vector<CachedPipeline> pipelines;  // least recently used first
+  LruCache<std::string, CachedPipeline> pipelines{kPipelineCache};  // by their source
 
   std::string device_text() const {
     const vulkan::Device& d = devices[static_cast<size_t>(chosen)];
@@ -279,17 +278,8 @@ struct VulkanBackend::Context {
 
   CachedPipeline& pipeline(const kernel::SceneTables<float>& tables, bool trace,
                            bool from_band = false) {
-    std::string key = kernel::scene_compute_shader(tables, trace, from_band);
-    auto it = std::find_if(pipelines.begin(), pipelines.end(),
-                           [&](const CachedPipeline& p) { return p.source == key; });
-    if (it == pipelines.end()) {
-      vk::raii::Pipeline made = make_pipeline(key);
-      if (pipelines.size() == kPipelineCache) pipelines.erase(pipelines.begin());
-      pipelines.push_back({std::move(key), std::move(made)});
-    } else {
-      std::rotate(it, it + 1, pipelines.end());  // now the most recently used
-    }
-    return pipelines.back();
+    const std::string source = kernel::scene_compute_shader(tables, trace, from_band);
+    return pipelines.get(source, [&] { return CachedPipeline{make_pipeline(source)}; });
   }
 
   // Records commands with `record`, runs them and waits for them, at most kBandTimeoutNs.
