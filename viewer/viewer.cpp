@@ -34,8 +34,6 @@ constexpr size_t kMaxPrograms = 8;
 constexpr double kTitlePeriod = 0.25;
 // Real time one frame moves the camera by at most, so that a stall does not jump it.
 constexpr double kMaxFrameTime = 0.1;
-// Rows a screenshot draws per draw call, as the OpenGL backend does (no long single draw).
-constexpr int kScreenshotBandRows = 64;
 // Screenshot file numbers tried for a free name at most.
 constexpr int kMaxScreenshotNumber = 100000;
 
@@ -489,24 +487,8 @@ void Viewer::screenshot(const std::filesystem::path& path) {
   Frame frame(width, height);
   {
     const gl::RenderTargets shot(gl_, width, height);  // bound until it goes
-    gl_.Viewport(0, 0, width, height);
-    gl_.Enable(GL_SCISSOR_TEST);
-    const CameraBasis<float> b = basis(width, height);
-    for (int row = 0; row < height; row += kScreenshotBandRows) {
-      const int rows = std::min(kScreenshotBandRows, height - row);
-      gl_.Scissor(0, row, width, rows);
-      kernel.draw(b, camera_.polygon, glm::vec3(camera_.position), width, height);
-    }
-    gl_.Disable(GL_SCISSOR_TEST);
-    std::vector<float> rgba(4 * static_cast<size_t>(width) * static_cast<size_t>(height));
-    gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
-    gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    gl_.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
-    for (int j = 0; j < height; ++j)  // OpenGL's rows go up, the image's down
-      for (int i = 0; i < width; ++i)
-        for (size_t n = 0; n < 3; ++n)
-          frame.rgb[3 * frame.pixel(i, j) + n] =
-              rgba[4 * (static_cast<size_t>(height - 1 - j) * width + i) + n];
+    gl::draw_frame(gl_, kernel, basis(width, height), camera_.polygon, glm::vec3(camera_.position),
+                   {}, frame, nullptr);
   }
   if (const std::string e = gl::errors(gl_); !e.empty())
     throw std::runtime_error("the viewer failed to draw a screenshot: " + e);

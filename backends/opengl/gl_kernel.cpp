@@ -1,6 +1,9 @@
 #include "backends/opengl/gl_kernel.hpp"
 
 #include <algorithm>
+#include <chrono>
+
+#include "backends/bands.hpp"
 
 #include "backends/kernel_trace.hpp"
 #include "kernels/scene_shader.hpp"
@@ -151,6 +154,45 @@ Trace KernelProgram::trace(const Ray& ray, int max_events) const {
   std::vector<unsigned char> data(bytes);
   gl_.GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(bytes), data.data());
   return shader_trace(data.data(), max_events);
+}
+
+void draw_frame(const Api& gl, const KernelProgram& program, const CameraBasis<float>& camera,
+                int polygon, glm::vec3 from, const Progress& progress, Frame& frame,
+                std::vector<float>* aovs) {
+  const int width = frame.width, height = frame.height;
+  gl.Viewport(0, 0, width, height);
+  gl.Enable(GL_SCISSOR_TEST);
+  // The image's row j is drawn at OpenGL's row j, so that the read-back is in the frame's order.
+  BandPacer bands(program.seconds_per_pixel(), width, height);
+  for (int row = 0, rows = 0; row < height; row += rows) {
+    rows = bands.rows(row);
+    const auto start = std::chrono::steady_clock::now();
+    gl.Scissor(0, row, width, rows);
+    program.draw(camera, polygon, from, width, height, KernelProgram::Rows::top_first);
+    gl.Finish();
+    bands.done(rows,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (progress) progress(static_cast<double>(row + rows) / height);
+  }
+  program.set_seconds_per_pixel(bands.pace());
+  gl.Disable(GL_SCISSOR_TEST);
+
+  // The colour straight into the frame; the AOVs through one read, spread into their channels.
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.ReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, frame.rgb.data());
+  if (!aovs) return;
+  const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+  aovs->resize(4 * pixels);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, aovs->data());
+  const float* aov = aovs->data();
+  for (size_t px = 0; px < pixels; ++px, aov += 4) {
+    frame.steps[px] = aov[0];
+    frame.crossings[px] = aov[1];
+    frame.hit[px] = aov[2];
+    frame.t[px] = aov[3];
+  }
 }
 
 }  // namespace flatmarch::gl

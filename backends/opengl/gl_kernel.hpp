@@ -78,4 +78,12 @@ class KernelProgram {
   mutable double seconds_per_pixel_ = 0.0;
 };
 
+// A whole width x height frame of `program` drawn into the bound render targets and read back:
+// in bands of rows (BandPacer, at the program's last pace; `progress` after each), the image's
+// rows top first, so that the read-back is in the frame's order. The colour goes into
+// frame.rgb; the AOVs too where `aovs` is given (read through it, the caller's buffer reused).
+void draw_frame(const Api& gl, const KernelProgram& program, const CameraBasis<float>& camera,
+                int polygon, glm::vec3 from, const Progress& progress, Frame& frame,
+                std::vector<float>* aovs);
+
 }  // namespace flatmarch::gl

@@ -149,44 +149,13 @@ Frame OpenGlBackend::render(const Scene& scene, const Camera& camera, int width,
     c.targets = std::make_unique<gl::RenderTargets>(gl, width, height);
   }
   c.targets->bind();
-  gl.Viewport(0, 0, width, height);
-  gl.Enable(GL_SCISSOR_TEST);
   const CameraBasis<float> basis = camera_basis<float>(
       float(camera.yaw_deg), float(camera.pitch_deg), float(camera.fov_deg), width, height);
-  // The image's row j is drawn at OpenGL's row j, so that the read-back is in the frame's order.
-  BandPacer bands(program.seconds_per_pixel(), width, height);
-  for (int row = 0, rows = 0; row < height; row += rows) {
-    rows = bands.rows(row);
-    const auto start = std::chrono::steady_clock::now();
-    gl.Scissor(0, row, width, rows);
-    program.draw(basis, camera.polygon, glm::vec3(camera.position), width, height,
-                 gl::KernelProgram::Rows::top_first);
-    gl.Finish();
-    bands.done(rows,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    if (progress) progress(static_cast<double>(row + rows) / height);
-  }
-  program.set_seconds_per_pixel(bands.pace());
-  gl.Disable(GL_SCISSOR_TEST);
-
-  // The colour straight into the frame; the AOVs through one read, spread into their channels.
   Frame frame(width, height);
-  const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
-  c.aovs.resize(4 * pixels);
-  gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  gl.ReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, frame.rgb.data());
-  gl.ReadBuffer(GL_COLOR_ATTACHMENT1);
-  gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, c.aovs.data());
+  gl::draw_frame(gl, program, basis, camera.polygon, glm::vec3(camera.position), progress, frame,
+                 &c.aovs);
   if (const std::string e = gl::errors(gl); !e.empty())
     throw std::runtime_error("the opengl backend failed to render: " + e);
-  const float* aov = c.aovs.data();
-  for (size_t px = 0; px < pixels; ++px, aov += 4) {
-    frame.steps[px] = aov[0];
-    frame.crossings[px] = aov[1];
-    frame.hit[px] = aov[2];
-    frame.t[px] = aov[3];
-  }
   return frame;
 }
 
