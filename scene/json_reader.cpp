@@ -73,7 +73,8 @@ void JsonNode::allow_keys(std::initializer_list<const char*> keys) const {
   object();
   for (const auto& item : value_->items()) {
     const std::string& key = item.key();
-    const bool known = std::any_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; });
+    const bool known =
+        std::any_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; });
     if (!known) {
       std::string list;
       for (const char* k : keys) list += std::string(list.empty() ? "" : ", ") + k;

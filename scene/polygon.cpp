@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -36,6 +37,24 @@ bool Polygon::contains(Vec2 p, double margin) const {
     }
   }
   return inside && distance_to_boundary(p) > margin;
+}
+
+Polygon::Exit Polygon::exit(Vec2 o, Vec2 d, double vertex_radius, double s_tolerance,
+                            double s_max) const {
+  Exit exit;
+  if (d.x == 0.0 && d.y == 0.0) return exit;
+  for (int i = 0; i < size(); ++i) {
+    const Edge& edge = edges[static_cast<size_t>(i)];
+    if (glm::dot(d, edge.normal) <= 0.0) continue;  // the path cannot leave through this edge
+    const Vec2 a = vertex(i), ab = vertex(i + 1) - a;
+    const double denom = cross(d, ab);
+    const double s = cross(a - o, ab) / denom;  // where the path meets the edge's line
+    const double u = cross(a - o, d) / denom;   // where along the edge, in [0, 1] on it
+    const double u_tol = vertex_radius / edge.length;
+    if (u < -u_tol || u > 1.0 + u_tol || s < -s_tolerance || s > s_max) continue;
+    if (s < exit.s) exit = {std::max(s, 0.0), i};
+  }
+  return exit;
 }
 
 double Polygon::distance_to_boundary(Vec2 p) const {

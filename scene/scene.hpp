@@ -5,6 +5,7 @@
 // from the file.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,6 +61,17 @@ struct Polygon {
   double distance_to_boundary(Vec2 p) const;
   // Interior angle at vertex i, in (0, 2pi).
   double corner_angle(int i) const;
+
+  // Where the path o + s d, s in [0, s_max], first leaves the polygon: through the first edge it
+  // crosses outward, at s (0 where it starts within s_tolerance behind the edge's line), or edge
+  // -1 if none. Passing within `vertex_radius` of an end of an edge counts as meeting it. The
+  // oracle's rays and the viewer's walks leave rooms by it.
+  struct Exit {
+    double s = std::numeric_limits<double>::infinity();
+    int edge = -1;
+  };
+  Exit exit(Vec2 o, Vec2 d, double vertex_radius, double s_tolerance,
+            double s_max = std::numeric_limits<double>::infinity()) const;
 };
 
 enum class ObjectType { hollow_cube, sphere, box, cylinder };

@@ -45,30 +45,6 @@ void check_camera(const Scene& scene, const Camera& camera) {
   }
 }
 
-// Where the path o + s d, s in [0, 1], first leaves the polygon.
-struct Exit {
-  double s = 2.0;
-  int edge = -1;
-};
-
-Exit find_exit(const Polygon& polygon, Vec2 o, Vec2 d, double vertex_radius) {
-  Exit exit;
-  const double s_tol = vertex_radius / glm::length(d);
-  for (int i = 0; i < polygon.size(); ++i) {
-    const Edge& edge = polygon.edges[static_cast<size_t>(i)];
-    if (glm::dot(d, edge.normal) <= 0.0) continue;  // the path cannot leave through this edge
-    const Vec2 a = polygon.vertex(i), ab = polygon.vertex(i + 1) - a;
-    const double denom = cross(d, ab);
-    const double s = cross(a - o, ab) / denom;  // where the path meets the edge's line
-    const double u = cross(a - o, d) / denom;   // where along the edge, in [0, 1] on it
-    // Passing just outside an end of the edge is meeting its vertex.
-    const double u_tol = vertex_radius / edge.length;
-    if (u < -u_tol || u > 1.0 + u_tol || s < -s_tol || s > 1.0) continue;
-    if (s < exit.s) exit = {std::max(s, 0.0), i};
-  }
-  return exit;
-}
-
 // The yaw after a gluing's linear part. A conformal map (translation, rotation, similarity) adds
 // its angle; a reflection mirrors the yaw about its axis; any other affine map turns it to where
 // it sends the forward direction.
@@ -97,7 +73,9 @@ void walk_rooms(const Scene& scene, Vec2 d, WalkResult& result) {
       break;
     }
     const Polygon& polygon = scene.polygons[static_cast<size_t>(camera.polygon)];
-    const Exit exit = find_exit(polygon, o, d, vertex_radius);
+    // Where the path o + s d, s in [0, 1], first leaves the room.
+    const Polygon::Exit exit =
+        polygon.exit(o, d, vertex_radius, vertex_radius / glm::length(d), 1.0);
     if (exit.edge < 0) {
       // The path ends in this room; an end on the boundary by rounding is not taken.
       if (polygon.contains(o + d))

@@ -17,29 +17,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Where a ray inside a room leaves it horizontally: the first edge it crosses outward.
-struct Exit {
-  double t = kInf;
-  int edge = -1;
-};
-
-Exit find_exit(const Polygon& polygon, Vec2 o, Vec2 dh) {
-  Exit exit;
-  if (dh.x == 0.0 && dh.y == 0.0) return exit;
-  for (int i = 0; i < polygon.size(); ++i) {
-    const Edge& edge = polygon.edges[static_cast<size_t>(i)];
-    if (glm::dot(dh, edge.normal) <= 0.0) continue;  // the ray cannot leave through this edge
-    const Vec2 a = polygon.vertex(i), ab = polygon.vertex(i + 1) - a;
-    const double denom = cross(dh, ab);
-    const double s = cross(a - o, ab) / denom;  // where the ray meets the edge's line
-    const double u = cross(a - o, dh) / denom;  // where along the edge, in [0, 1] on it
-    const double u_tol = kVertexTolerance / edge.length;
-    if (u < -u_tol || u > 1.0 + u_tol || s < -kVertexTolerance) continue;
-    if (s < exit.t) exit = {std::max(s, 0.0), i};
-  }
-  return exit;
-}
-
 // The first vertex of the polygon the ray meets (passes within kVertexTolerance of) for
 // t in (0, limit].
 struct VertexMeet {
@@ -150,10 +127,11 @@ class Tracer {
   bool step() {
     const Polygon& polygon = scene_.polygons[static_cast<size_t>(p_)];
     const Vec2 o(o_), dh(d_);
-    const Exit exit = find_exit(polygon, o, dh);
-    VertexMeet vertex = find_vertex(polygon, o, dh, exit.t);
+    // Where it leaves the room horizontally: the first edge it crosses outward.
+    const Polygon::Exit exit = polygon.exit(o, dh, kVertexTolerance, kVertexTolerance);
+    VertexMeet vertex = find_vertex(polygon, o, dh, exit.s);
     // A vertex met at the exit point may lie a rounding error beyond it; it still comes first.
-    if (vertex.vertex >= 0) vertex.t = std::min(vertex.t, exit.t);
+    if (vertex.vertex >= 0) vertex.t = std::min(vertex.t, exit.s);
 
     double band = kInf;  // leaving the band: escape, floor, or a period wrap
     const double top = scene_.period ? *scene_.period : scene_.height;
@@ -162,9 +140,9 @@ class Tracer {
     const double remaining = params_.max_distance - t_;
 
     const ObjectMeet object =
-        find_object(scene_, p_, o_, d_, std::min({exit.t, vertex.t, band, remaining}));
+        find_object(scene_, p_, o_, d_, std::min({exit.s, vertex.t, band, remaining}));
     // Ties go to the object, then the vertex, then the band, then the edge.
-    const double first = std::min({object.t, vertex.t, band, exit.t});
+    const double first = std::min({object.t, vertex.t, band, exit.s});
     if (first > remaining) return finish(EventKind::max_distance, kHitMaxDistance, remaining, -1);
     if (object.t == first)
       return finish(EventKind::object, object.index, object.t, -1, object.normal);
@@ -183,17 +161,17 @@ class Tracer {
       return finish(EventKind::vertex, kHitVertex, 0.0, -1);  // numerically cornered
 
     const Edge& edge = polygon.edges[static_cast<size_t>(exit.edge)];
-    const Vec3 at = o_ + exit.t * d_;
+    const Vec3 at = o_ + exit.s * d_;
     switch (edge.kind) {
       case EdgeKind::wall:
-        return finish(EventKind::wall, kHitWall, exit.t, exit.edge, Vec3(-edge.normal, 0.0));
+        return finish(EventKind::wall, kHitWall, exit.s, exit.edge, Vec3(-edge.normal, 0.0));
       case EdgeKind::mirror: {
         record({.kind = EventKind::mirror,
                 .polygon = p_,
                 .edge = exit.edge,
-                .t = t_ + exit.t,
+                .t = t_ + exit.s,
                 .at = at});
-        advance(exit.t);
+        advance(exit.s);
         const Vec2 reflected = dh - 2.0 * glm::dot(dh, edge.normal) * edge.normal;
         d_ = glm::normalize(Vec3(reflected, d_.z));
         break;
@@ -204,9 +182,9 @@ class Tracer {
                 .edge = exit.edge,
                 .to_polygon = edge.to.polygon,
                 .to_edge = edge.to.edge,
-                .t = t_ + exit.t,
+                .t = t_ + exit.s,
                 .at = at});
-        advance(exit.t);
+        advance(exit.s);
         o_ = Vec3(edge.map.apply(Vec2(o_)), o_.z);
         // Under a non-isometric map the horizontal direction follows the linear part and the
         // 3D direction is renormalised (DESIGN.md section 1).
