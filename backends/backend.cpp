@@ -114,7 +114,14 @@ std::vector<BackendEntry>& registry() {
                         "with its",
        .make = [](const BackendOptions&) { return std::make_unique<ScalarBackend>(); }},
       {.name = "simd",
-       .make = [](const BackendOptions& o) { return std::make_unique<SimdBackend>(o); }},
+       .make = [](const BackendOptions& o) { return std::make_unique<SimdBackend>(o); },
+       .variants =
+           [] {
+             std::vector<std::pair<std::string, BackendOptions>> v;
+             for (const std::string& isa : simd::isa_names(false))
+               v.push_back({isa, BackendOptions{.isa = isa}});
+             return v;
+           }},
       {.name = "opengl",
        .make = [](const BackendOptions& o) { return std::make_unique<OpenGlBackend>(o); }},
       {.name = "vulkan",

@@ -198,6 +198,9 @@ struct BackendEntry {
   // What its results are the reference for, where they are one (`flatmarch backends` says).
   std::string reference_for{};
   std::function<std::unique_ptr<Backend>(const BackendOptions&)> make;
+  // The variants the contract tests hold to the contract besides the default one: a name and the
+  // options that make it (simd: each instruction set compiled in). None if null.
+  std::function<std::vector<std::pair<std::string, BackendOptions>>()> variants{};
 };
 
 // The registered backends: the built-in ones, then any a program added.

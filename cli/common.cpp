@@ -87,21 +87,17 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
 }
 
 void add_march_param_options(CLI::App& app, MarchParams& params, MarchParamOptions which) {
-  if (which.eps) app.add_option("--eps", params.eps, "Hit threshold, > 0")->capture_default_str();
-  if (which.offset)
-    app.add_option("--offset", params.offset, "Re-entry push after a gluing, > 0")
-        ->capture_default_str();
-  if (which.max_steps)
-    app.add_option("--max-steps", params.max_steps,
-                   "Kernel iterations before a ray gives up, in [1, 1e8]")
-        ->capture_default_str();
-  if (which.max_distance)
-    app.add_option("--max-distance", params.max_distance, "Path length before a ray gives up, > 0")
-        ->capture_default_str();
-  if (which.omega)
-    app.add_option("--omega", params.omega,
-                   "Over-relaxation factor of the relaxed method, in [1, 2)")
-        ->capture_default_str();
+  const auto add = [&app](bool wanted, const char* name, auto& value, const char* help) {
+    if (wanted) app.add_option(name, value, help)->capture_default_str();
+  };
+  add(which.eps, "--eps", params.eps, "Hit threshold, > 0");
+  add(which.offset, "--offset", params.offset, "Re-entry push after a gluing, > 0");
+  add(which.max_steps, "--max-steps", params.max_steps,
+      "Kernel iterations before a ray gives up, in [1, 1e8]");
+  add(which.max_distance, "--max-distance", params.max_distance,
+      "Path length before a ray gives up, > 0");
+  add(which.omega, "--omega", params.omega,
+      "Over-relaxation factor of the relaxed method, in [1, 2)");
 }
 
 void add_backend_options(CLI::App& app, BackendOptions& options) {

@@ -1,7 +1,8 @@
-// What every kernel backend promises, tested once over the registry (backend_registry()): a
-// backend registered there, a test's own included, is held to all of it with no other edit.
-// Each backend's own test file keeps only what is specific to it (devices, shaders, ISAs,
-// threads). A backend unavailable here is skipped, visibly, with its reason.
+// What every kernel backend promises, tested once over the registry (backend_registry()) and the
+// variants it lists (simd: every instruction set): a backend registered there, a test's own
+// included, is held to all of it with no other edit. Each backend's own test file keeps only
+// what is specific to it (devices, shaders, lane counts). A backend unavailable here is skipped,
+// visibly, with its reason.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,13 +19,32 @@
 namespace flatmarch {
 namespace {
 
-class BackendContract : public testing::TestWithParam<std::string> {
+// A registered kernel backend with its default options, or one of its variants (simd: each
+// instruction set).
+struct Variant {
+  std::string backend, label;  // label: "" for the default
+  BackendOptions options;
+};
+
+std::vector<Variant> variants() {
+  std::vector<Variant> all;
+  for (const BackendEntry& e : backend_registry()) {
+    if (!e.kernel) continue;
+    all.push_back({e.name, "", {}});
+    if (e.variants)
+      for (const auto& [label, options] : e.variants()) all.push_back({e.name, label, options});
+  }
+  return all;
+}
+
+class BackendContract : public testing::TestWithParam<Variant> {
  protected:
   void SetUp() override {
-    backend_ = make_backend(GetParam(), {});
-    ASSERT_NE(backend_, nullptr) << GetParam() << " is registered but makes no backend";
+    backend_ = make_backend(GetParam().backend, GetParam().options);
+    ASSERT_NE(backend_, nullptr) << GetParam().backend << " is registered but makes no backend";
     if (const Availability a = backend_->availability(); !a.available)
-      GTEST_SKIP() << "the " << GetParam() << " backend is unavailable here: " << a.reason;
+      GTEST_SKIP() << "the " << GetParam().backend << " backend (" << GetParam().label
+                   << ") is unavailable here: " << a.reason;
   }
 
   // How far a backend may stray from the scalar kernel, and why.
@@ -69,7 +89,7 @@ TEST_P(BackendContract, RefusesWhatItCannotMarchAndSaysWhy) {
     } catch (const std::invalid_argument& e) {
       // It names itself and what it does march in.
       const std::string why = e.what();
-      EXPECT_NE(why.find(GetParam()), std::string::npos) << why;
+      EXPECT_NE(why.find(GetParam().backend), std::string::npos) << why;
       EXPECT_NE(why.find(p == Precision::f64 ? "f32" : "f64"), std::string::npos) << why;
     }
   }
@@ -114,8 +134,31 @@ TEST_P(BackendContract, ARepeatedFrameIsTheSame) {
   EXPECT_TRUE(a.hit == b.hit && a.steps == b.steps && a.t == b.t && a.rgb == b.rgb);
 }
 
-INSTANTIATE_TEST_SUITE_P(Registered, BackendContract, testing::ValuesIn(kernel_backend_names()),
-                         [](const testing::TestParamInfo<std::string>& p) { return p.param; });
+TEST_P(BackendContract, ThreadsDoNotChangeTheFrame) {
+  // However a backend spreads a frame over threads (--threads; ignored where it has none), each
+  // pixel's ray is marched alone: one thread and three give the same frame, at a size no tile
+  // divides.
+  const Scene& scene = test::gallery_scene("double_pentagon");
+  MarchParams params;
+  params.method = Method::relaxed;
+  std::vector<Frame> frames;
+  for (const int threads : {1, 3}) {
+    BackendOptions options = GetParam().options;
+    options.threads = threads;
+    frames.push_back(make_backend(GetParam().backend, options)
+                         ->render(scene, scene.camera, 101, 57, params, {}));
+  }
+  EXPECT_EQ(frames[0].rgb, frames[1].rgb);
+  EXPECT_EQ(frames[0].steps, frames[1].steps);
+  EXPECT_EQ(frames[0].hit, frames[1].hit);
+  EXPECT_EQ(frames[0].t, frames[1].t);
+}
+
+INSTANTIATE_TEST_SUITE_P(Registered, BackendContract, testing::ValuesIn(variants()),
+                         [](const testing::TestParamInfo<Variant>& p) {
+                           return p.param.backend +
+                                  (p.param.label.empty() ? "" : "_" + p.param.label);
+                         });
 
 }  // namespace
 }  // namespace flatmarch

@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "scene/load.hpp"
 #include "interop/peer_import.hpp"
+#include "scene/load.hpp"
 #include "tests/process.hpp"
 
 namespace flatmarch {
