@@ -110,8 +110,8 @@ std::vector<BackendEntry>& registry() {
        .reference_for = "the true image and every ray's path (exact, analytic)",
        .make = [](const BackendOptions&) { return std::make_unique<OracleBackend>(); }},
       {.name = "scalar",
-       .reference_for = "the kernel's steps: every other kernel backend's traces are compared "
-                        "with its",
+       .reference_for = "the kernel's steps: the other kernel backends' traces and frames are "
+                        "compared with its",
        .make = [](const BackendOptions&) { return std::make_unique<ScalarBackend>(); }},
       {.name = "simd",
        .make = [](const BackendOptions& o) { return std::make_unique<SimdBackend>(o); },

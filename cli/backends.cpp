@@ -9,6 +9,7 @@
 #include "backends/simd/simd.hpp"
 #include "backends/vulkan/vulkan.hpp"
 #include "cli/commands.hpp"
+#include "cli/common.hpp"
 
 namespace flatmarch::cli {
 
@@ -86,9 +87,8 @@ void add_backends(CLI::App& app) {
       if (const std::string r = b["reference_for"].get<std::string>(); !r.empty())
         std::printf("%s is the reference for %s\n", b["name"].get<std::string>().c_str(),
                     r.c_str());
-    std::string isas;
-    for (const std::string& name : simd::isa_names(true)) isas += (isas.empty() ? "" : ", ") + name;
-    std::printf("\nsimd instruction sets this CPU runs (--isa), best first: %s\n", isas.c_str());
+    std::printf("\nsimd instruction sets this CPU runs (--isa), best first: %s\n",
+                joined(simd::isa_names(true)).c_str());
     for (const auto& b : list) {
       if (!b.contains("devices")) continue;
       const std::string name = b["name"].get<std::string>();

@@ -73,10 +73,9 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
                           const std::string& fallback) {
   default_backend = default_name;
   fallback_ = fallback;
-  std::string names;
-  for (const auto& b : backends()) names += (names.empty() ? "" : ", ") + b->name();
   app.add_option("--backend", backend,
-                 "Backend: " + names + " (see `flatmarch backends`); default: " + default_name +
+                 "Backend: " + joined(backend_names()) +
+                     " (see `flatmarch backends`); default: " + default_name +
                      (fallback != default_name ? " where available, else " + fallback : ""));
   app.add_option("--method", method,
                  "Method: " + method_names() + " (default: the backend's first)");
@@ -119,9 +118,8 @@ void check_backend_options(const BackendOptions& options) {
   if (options.threads < 0) throw UsageError("--threads: must be 0 (all cores) or more");
   const std::vector<std::string> isas = simd::isa_names(false);
   if (!options.isa.empty() && std::find(isas.begin(), isas.end(), options.isa) == isas.end()) {
-    std::string list;
-    for (const std::string& name : isas) list += (list.empty() ? "" : ", ") + name;
-    throw UsageError("--isa: unknown instruction set \"" + options.isa + "\" (" + list + ")");
+    throw UsageError("--isa: unknown instruction set \"" + options.isa + "\" (" + joined(isas) +
+                     ")");
   }
 }
 
@@ -265,10 +263,16 @@ std::vector<Scene> load_scenes(const std::vector<std::string>& names,
   return scenes;
 }
 
+std::string joined(const std::vector<std::string>& words) {
+  std::string text;
+  for (const std::string& w : words) text += (text.empty() ? "" : ", ") + w;
+  return text;
+}
+
 std::string kernel_method_names() {
-  std::string names;
-  for (Method m : kKernelMethods) names += (names.empty() ? "" : ", ") + std::string(to_string(m));
-  return names;
+  std::vector<std::string> names;
+  for (Method m : kKernelMethods) names.push_back(to_string(m));
+  return joined(names);
 }
 
 std::vector<Method> parse_methods(const std::vector<std::string>& names) {

@@ -42,7 +42,9 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
 std::vector<Scene> load_scenes(const std::vector<std::string>& names,
                                const std::vector<std::string>& galleries);
 
-// The kernel's methods, named in order and joined by ", " (help texts and errors).
+// Words joined by ", " (lists in help texts and errors).
+std::string joined(const std::vector<std::string>& words);
+// The kernel's methods, named in order and joined (help texts and errors).
 std::string kernel_method_names();
 
 // The kernel methods named by --method options (UsageError for another name); all three when

@@ -100,8 +100,8 @@ void add_report(CLI::App& app) {
                 "The full matrix: frames 640x360, 5 repetitions, the sweep on every scene, longer "
                 "scaling series on every backend");
   cmd->add_option("--backend", o->backends,
-                  "Backend to measure (repeat; default: scalar, simd, opengl, vulkan — those "
-                  "unavailable here skipped with the reason)");
+                  "Backend to measure (repeat; default: " + joined(kernel_backend_names()) +
+                      " — those unavailable here skipped with the reason)");
   cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
   cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
   cmd->add_option("--method", o->methods, kernel_method_names() + " (repeat; default: all)");
@@ -176,12 +176,9 @@ void add_report(CLI::App& app) {
     if (r.sweep_enabled) {
       const std::unique_ptr<Backend> b = make_backend(r.sweep.backend, o->backend_options);
       const std::vector<std::string> kernel = kernel_backend_names();
-      if (!b || std::find(kernel.begin(), kernel.end(), r.sweep.backend) == kernel.end()) {
-        std::string names;
-        for (const std::string& n : kernel) names += (names.empty() ? "" : ", ") + n;
-        throw UsageError("--sweep-backend: expected one of " + names + ", got \"" +
+      if (!b || std::find(kernel.begin(), kernel.end(), r.sweep.backend) == kernel.end())
+        throw UsageError("--sweep-backend: expected one of " + joined(kernel) + ", got \"" +
                          r.sweep.backend + "\"");
-      }
       if (const Availability a = b->availability(); !a.available)
         throw UnavailableError("--sweep-backend: the " + r.sweep.backend +
                                " backend is unavailable here: " + a.reason);
