@@ -121,11 +121,25 @@ std::vector<BackendEntry>& registry() {
              for (const std::string& isa : simd::isa_names(false))
                v.push_back({isa, BackendOptions{.isa = isa}});
              return v;
-           }},
+           },
+       .options = {{"--isa", &BackendOptions::isa,
+                    "the instruction set, one of those `flatmarch backends` lists (default: the "
+                    "best this CPU runs)"},
+                   {"--threads", &BackendOptions::threads, "worker threads (0: all cores)"}}},
       {.name = "opengl",
-       .make = [](const BackendOptions& o) { return std::make_unique<OpenGlBackend>(o); }},
+       .make = [](const BackendOptions& o) { return std::make_unique<OpenGlBackend>(o); },
+       .options = {{"--device", &BackendOptions::device,
+                    "the device, by its index or a part of its name as `flatmarch backends` "
+                    "lists them (default: a GPU, else the CPU: llvmpipe through EGL, then "
+                    "OSMesa)"}}},
       {.name = "vulkan",
-       .make = [](const BackendOptions& o) { return std::make_unique<VulkanBackend>(o); }},
+       .make = [](const BackendOptions& o) { return std::make_unique<VulkanBackend>(o); },
+       .options = {{"--device", &BackendOptions::device,
+                    "likewise "
+                    "(default: a discrete, integrated or virtual GPU, else lavapipe)"},
+                   {"--vk-staging", &BackendOptions::vk_staging,
+                    "read frames back through a staging buffer, as on a discrete GPU, even where "
+                    "the device's memory is host-visible"}}},
   };
   return entries;
 }

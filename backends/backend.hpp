@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "kernels/constants.hpp"
@@ -190,6 +191,14 @@ class Backend {
 // report's and the benchmarks') is read from here: adding a backend is adding an entry.
 
 // A backend as the project's lists know it.
+// A command-line option a backend adds, the field of BackendOptions it sets, and its help (the
+// CLI declares each flag once, with the help of every backend that adds it).
+struct BackendOption {
+  std::string flag;  // "--isa"
+  std::variant<std::string BackendOptions::*, int BackendOptions::*, bool BackendOptions::*> field;
+  std::string help;
+};
+
 struct BackendEntry {
   std::string name;
   // Runs the march kernel: the conformance suite, the report and the benchmarks measure it
@@ -201,6 +210,8 @@ struct BackendEntry {
   // The variants the contract tests hold to the contract besides the default one: a name and the
   // options that make it (simd: each instruction set compiled in). None if null.
   std::function<std::vector<std::pair<std::string, BackendOptions>>()> variants{};
+  // The options it takes beyond the march parameters.
+  std::vector<BackendOption> options{};
 };
 
 // The registered backends: the built-in ones, then any a program added.

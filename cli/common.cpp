@@ -10,6 +10,8 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <type_traits>
+#include <variant>
 
 #include "backends/oracle/oracle.hpp"
 #include "backends/simd/simd.hpp"
@@ -100,18 +102,30 @@ void add_march_param_options(CLI::App& app, MarchParams& params, MarchParamOptio
 }
 
 void add_backend_options(CLI::App& app, BackendOptions& options) {
-  app.add_option("--isa", options.isa,
-                 "simd: the instruction set, one of those `flatmarch backends` lists (default: "
-                 "the best this CPU runs)");
-  app.add_option("--threads", options.threads, "simd: worker threads (0: all cores)")
-      ->capture_default_str();
-  app.add_option("--device", options.device,
-                 "opengl, vulkan: the device, by its index or a part of its name as `flatmarch "
-                 "backends` lists them (default: a GPU, else the CPU: llvmpipe through EGL, then "
-                 "OSMesa; lavapipe)");
-  app.add_flag("--vk-staging", options.vk_staging,
-               "vulkan: read frames back through a staging buffer, as on a discrete GPU, even "
-               "where the device's memory is host-visible");
+  // Each flag once, in the registry's order, with the help of every backend that adds it.
+  std::vector<const BackendOption*> flags;
+  std::vector<std::string> helps;
+  for (const BackendEntry& e : backend_registry())
+    for (const BackendOption& o : e.options) {
+      const auto same = [&](const BackendOption* f) { return f->flag == o.flag; };
+      const auto at = std::find_if(flags.begin(), flags.end(), same);
+      if (at == flags.end()) {
+        flags.push_back(&o);
+        helps.push_back(e.name + ": " + o.help);
+      } else {
+        helps[static_cast<size_t>(at - flags.begin())] += "; " + e.name + ": " + o.help;
+      }
+    }
+  for (size_t k = 0; k < flags.size(); ++k)
+    std::visit(
+        [&](auto field) {
+          auto& value = options.*field;
+          if constexpr (std::is_same_v<std::decay_t<decltype(value)>, bool>)
+            app.add_flag(flags[k]->flag, value, helps[k]);
+          else
+            app.add_option(flags[k]->flag, value, helps[k])->capture_default_str();
+        },
+        flags[k]->field);
 }
 
 void check_backend_options(const BackendOptions& options) {
