@@ -190,7 +190,6 @@ class Backend {
 // Every list of backends in the project (the CLI's, the conformance suite's and its tests', the
 // report's and the benchmarks') is read from here: adding a backend is adding an entry.
 
-// A backend as the project's lists know it.
 // A command-line option a backend adds, the field of BackendOptions it sets, and its help (the
 // CLI declares each flag once, with the help of every backend that adds it).
 struct BackendOption {
@@ -199,6 +198,7 @@ struct BackendOption {
   std::string help;
 };
 
+// A backend as the project's lists know it.
 struct BackendEntry {
   std::string name;
   // Runs the march kernel: the conformance suite, the report and the benchmarks measure it

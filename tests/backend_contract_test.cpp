@@ -154,6 +154,21 @@ TEST_P(BackendContract, ThreadsDoNotChangeTheFrame) {
   EXPECT_EQ(frames[0].t, frames[1].t);
 }
 
+// The registry itself: what backends() and the name lists hold, and what it refuses.
+TEST(Registry, ListsEveryBackendOnceInItsOrder) {
+  std::vector<std::string> made;
+  for (const auto& b : backends()) made.push_back(b->name());
+  EXPECT_EQ(made, backend_names());
+  const std::vector<std::string> kernel = kernel_backend_names();
+  EXPECT_EQ(std::count(kernel.begin(), kernel.end(), "oracle"), 0);  // the truth, not a kernel
+  EXPECT_EQ(std::count(kernel.begin(), kernel.end(), "noop"), 1);    // tests/backends/noop.cpp
+  EXPECT_EQ(kernel.size() + 1, made.size());
+  // Closed once backends() has made its list, and never two of one name.
+  const auto make = [](const BackendOptions&) { return make_backend("scalar", {}); };
+  EXPECT_THROW(register_backend({.name = "late", .make = make}), std::logic_error);
+  EXPECT_THROW(register_backend({.name = "scalar", .make = make}), std::logic_error);
+}
+
 INSTANTIATE_TEST_SUITE_P(Registered, BackendContract, testing::ValuesIn(variants()),
                          [](const testing::TestParamInfo<Variant>& p) {
                            return p.param.backend +
