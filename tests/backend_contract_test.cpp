@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -25,6 +26,10 @@ struct Variant {
   std::string backend, label;  // label: "" for the default
   BackendOptions options;
 };
+
+void PrintTo(const Variant& v, std::ostream* os) {
+  *os << v.backend << (v.label.empty() ? "" : " " + v.label);
+}
 
 std::vector<Variant> variants() {
   std::vector<Variant> all;
