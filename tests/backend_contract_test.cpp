@@ -48,8 +48,8 @@ class BackendContract : public testing::TestWithParam<Variant> {
     backend_ = make_backend(GetParam().backend, GetParam().options);
     ASSERT_NE(backend_, nullptr) << GetParam().backend << " is registered but makes no backend";
     if (const Availability a = backend_->availability(); !a.available)
-      GTEST_SKIP() << "the " << GetParam().backend << " backend (" << GetParam().label
-                   << ") is unavailable here: " << a.reason;
+      GTEST_SKIP() << "the " << testing::PrintToString(GetParam())
+                   << " backend is unavailable here: " << a.reason;
   }
 
   // How far a backend may stray from the scalar kernel, and why.
