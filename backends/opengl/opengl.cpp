@@ -1,11 +1,8 @@
 #include "backends/opengl/opengl.hpp"
 
-#include <algorithm>
-#include <chrono>
 #include <mutex>
 #include <stdexcept>
 
-#include "backends/bands.hpp"
 #include "backends/lru_cache.hpp"
 #include "backends/opengl/context.hpp"
 #include "backends/opengl/gl_api.hpp"
