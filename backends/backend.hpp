@@ -130,6 +130,21 @@ struct Frame {
     hit[px] = ray_hit;
     t[px] = ray_t;
   }
+  // Paints the pixels whose rays failed (max_steps, max_distance, vertex) in `loud`, for people
+  // studying the methods (render --show-failures); returns how many. The kernel shades them
+  // as fog.
+  int paint_failures(Vec3 loud) {
+    int painted = 0;
+    for (size_t px = 0; px < hit.size(); ++px) {
+      const int h = static_cast<int>(hit[px]);
+      if (h != kHitMaxSteps && h != kHitMaxDistance && h != kHitVertex) continue;
+      rgb[3 * px] = static_cast<float>(loud.x);
+      rgb[3 * px + 1] = static_cast<float>(loud.y);
+      rgb[3 * px + 2] = static_cast<float>(loud.z);
+      ++painted;
+    }
+    return painted;
+  }
 };
 
 // The device a GPU backend runs on, named beside every figure it produces.

@@ -85,8 +85,12 @@ void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
                  "Backend: " + joined(names) +
                      " (see `flatmarch backends`); default: " + default_name +
                      (fallback != default_name ? " where available, else " + fallback : ""));
-  app.add_option("--method", method,
-                 "Method: " + method_names() + " (default: the backend's first)");
+  app.add_option(
+      "--method", method,
+      "Method: " + method_names() + " (default: " +
+          (default_method.empty() ? std::string()
+                                  : default_method + " where the backend runs it, else ") +
+          "the backend's first)");
   add_march_param_options(app, params);
   app.add_option("--precision", precision, "f32 or f64 (f64 on the oracle and scalar backends)")
       ->capture_default_str();
@@ -201,7 +205,11 @@ const Backend& MarchOptions::resolve() {
   if (!a.available)
     throw UnavailableError("backend " + backend + " is unavailable here: " + a.reason);
   const std::vector<Method> methods = b->methods();
-  if (method.empty()) {
+  const auto preferred = parse_method(default_method);
+  if (method.empty() && preferred &&
+      std::find(methods.begin(), methods.end(), *preferred) != methods.end()) {
+    params.method = *preferred;
+  } else if (method.empty()) {
     params.method = methods.front();
   } else {
     const auto m = parse_method(method);

@@ -88,7 +88,8 @@ void warn_about_resolution(const Scene& scene, const MarchParams& params);
 struct MarchOptions {
   std::string backend;  // empty: default_backend
   std::string default_backend = "oracle";
-  std::string method;  // empty: the backend's first method
+  std::string method;  // empty: default_method where the backend runs it, else its first
+  std::string default_method;
   MarchParams params;
   std::string precision = "f32";
   BackendOptions backend_options;

@@ -15,7 +15,7 @@ void add_render(CLI::App& app) {
       "R, G, B (linear), steps, crossings, hit, t (DESIGN.md section 4).");
   struct Options {
     std::string scene, out, size = "640x360";
-    bool quiet = false;
+    bool quiet = false, show_failures = false;
     MarchOptions march;
     CameraOptions camera;
   };
@@ -24,6 +24,12 @@ void add_render(CLI::App& app) {
   cmd->add_option("-o,--output", o->out, "Output PNG; the EXR goes beside it")->required();
   cmd->add_option("--size", o->size, "Image size WxH")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No progress or summary on stderr");
+  cmd->add_flag("--show-failures", o->show_failures,
+                "Paint the pixels whose rays failed (max_steps, max_distance, vertex) magenta, in "
+                "the PNG and the EXR's colour, rather than as the fog they are shaded as; the hit "
+                "AOV says which failure each is");
+  // The exact method and the fastest; the paper's sphere tracing is --method sphere.
+  o->march.default_method = "analytic";
   o->march.add_to(*cmd, "simd", "scalar");
   o->camera.add_to(*cmd);
   cmd->callback([o] {
@@ -35,11 +41,16 @@ void add_render(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     ProgressReporter progress("rendering " + scene.name + " " + o->size + " with " + backend.name(),
                               o->quiet);
-    const Frame frame =
+    Frame frame =
         backend.render(scene, camera, w, h, o->march.params, [&](double f) { progress(f); });
     progress.done();
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (o->show_failures) {
+      const int failed = frame.paint_failures(Vec3(1.0, 0.0, 1.0));
+      if (!o->quiet)
+        std::fprintf(stderr, "%d of %d pixels failed (painted magenta)\n", failed, w * h);
+    }
     write_png(frame, o->out);
     write_aov_exr(frame, aov_path(o->out));
     if (!o->quiet)

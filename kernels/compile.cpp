@@ -107,6 +107,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
         r.link.y = edge.to.polygon;
         r.link.z = edge.to.edge;
       }
+      r.tint = vec4(edge_tint(scene.look, edge));
       t.edges.push_back(r);
     }
     // The room's solids: its objects, then a cylinder at each corner that carries a marker.
@@ -146,15 +147,36 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
   // The step that balances rounding against truncation in central differences.
   k.normal_step = real(std::cbrt(kUlp) * scene.scale);
   set_look<real>(scene.look, k);
+  k.period_tint = vec4(period_tint(scene));
   return t;
+}
+
+glm::dvec4 edge_tint(const Look& look, const Edge& edge) {
+  switch (edge.kind) {
+    case EdgeKind::glued:
+      return {look.gluing_colour(edge.gluing), look.wall_tint};
+    case EdgeKind::mirror:
+      return {look.mirror, look.wall_tint};
+    case EdgeKind::wall:
+      break;
+  }
+  return glm::dvec4(0.0);
 }
 
 template <typename real>
 void set_look(const Look& look, typename Tables<real>::KernelParams& params) {
   using vec4 = typename Types<real>::vec4;
-  params.wall_tint = real(look.wall_tint);
-  params.fog = vec4(glm::vec<3, real>(look.fog), 0);
-  params.background = vec4(glm::vec<3, real>(look.background), 0);
+  const auto colour = [](Vec3 c) { return vec4(glm::vec<3, real>(c), 0); };
+  params.fog_distance = real(look.fog_distance);
+  params.fog = colour(look.fog);
+  params.sky = colour(look.sky);
+  params.ground = colour(look.ground);
+  params.wall = colour(look.wall);
+  params.floor_colour = colour(look.floor);
+}
+
+glm::dvec4 period_tint(const Scene& scene) {
+  return {scene.look.gluing_colour(static_cast<int>(scene.gluings.size())), scene.look.wall_tint};
 }
 
 template SceneTables<float> compile_scene(const Scene&, const MarchParams&);

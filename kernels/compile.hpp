@@ -26,6 +26,14 @@ uint scene_features(const Scene& scene);
 template <typename real>
 SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march);
 
+// What crossing an edge does to a ray's colour: the colour it mixes in (xyz) and its opacity at
+// normal incidence (w), as the edge table's `tint` holds it.
+glm::dvec4 edge_tint(const Look& look, const Edge& edge);
+
+// What crossing the glued floor and ceiling of a translation prism does to a ray's colour, as
+// edge_tint: the colour after the gluings' (Look::gluing_colour).
+glm::dvec4 period_tint(const Scene& scene);
+
 // The appearance part of the kernel's parameters.
 template <typename real>
 void set_look(const Look& look, typename Tables<real>::KernelParams& params);

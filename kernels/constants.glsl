@@ -51,8 +51,13 @@ KCONST uint kFeatureCount = 64u;   // number of feature sets
 // A distance no ray reaches.
 KCONST float kFar = 1e30f;
 
-// Appearance: opaque walls are light grey; the floor alternates it with a darker grey in
-// checks of this side.
-KCONST float kWallGrey = 0.8f;
-KCONST float kFloorDarkGrey = 0.55f;
+// Appearance (DESIGN.md section 1): the floor's checks are this wide, the dark ones this share
+// of the light ones; surfaces are lit by a light from this unit direction (above, from the
+// side) and this much ambient light.
 KCONST float kFloorCheck = 0.5f;
+KCONST float kFloorDark = 0.42f;
+KCONST float kLightX = 0.35f;
+KCONST float kLightY = 0.55f;
+KCONST float kLightZ = 0.758288f;  // sqrt(1 - 0.35^2 - 0.55^2)
+KCONST float kAmbient = 0.45f;
+KCONST float kExposure = 0.8f;

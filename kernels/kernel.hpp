@@ -23,8 +23,8 @@ struct Tables {
 
 // The parameters go to shaders as a std140 uniform block: 12 scalars, then 16-byte aligned vec4s.
 static_assert(offsetof(Tables<float>::KernelParams, fog) == 48 &&
-              sizeof(Tables<float>::KernelParams) == 80);
-static_assert(sizeof(Tables<float>::EdgeRecord) == 80 && sizeof(Tables<float>::ObjectRecord) == 64);
+              sizeof(Tables<float>::KernelParams) == 144);
+static_assert(sizeof(Tables<float>::EdgeRecord) == 96 && sizeof(Tables<float>::ObjectRecord) == 64);
 
 // A transport event as the kernel reports it (EventKind numbering, kEvent*).
 struct KernelEvent {

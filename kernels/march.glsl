@@ -59,8 +59,10 @@ struct Ray {
   int hit;        // the hit AOV, once done
   bool done;
   int object;    // the index in the object table of the solid hit, or -1
-  vec3 normal;   // of the solid hit
+  vec3 normal;   // of the solid, wall or floor hit
   vec3 surface;  // the colour of the solid hit
+  vec3 light;    // what the walls crossed give (tint_light)
+  real clear;    // the share of light beyond them that they let through
 };
 
 void advance(INOUT(Ray) r, real s) {
@@ -166,10 +168,21 @@ Exit exit_edge(int polygon, vec2 o, vec2 dh) {
 // mirror. Either way its point is then placed `push` inside the edge it is now behind (the
 // paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
 // one it was.
+// A glued wall or mirror of tint `tint` (the edge table's), crossed with the component
+// `cosine` of the ray's direction along its normal, tints what lies beyond it (DESIGN.md
+// section 1, Appearance), seen through the fog as far away as it is.
+void tint_ray(INOUT(Ray) r, vec4 tint, real cosine) {
+  real a = wall_opacity(tint.w, cosine);
+  vec3 colour = fogged(vec3(tint), vec3(params.fog), r.t, params.fog_distance);
+  r.light = tint_light(r.light, r.clear, a, colour);
+  r.clear = r.clear * (real(1) - a);
+}
+
 void cross_edge(INOUT(Ray) r, int k, real push) {
   EdgeRecord edge = edge_at(r.polygon, k);
   vec4 line = edge.line;
   vec2 dh = vec2(r.d);
+  tint_ray(r, edge.tint, dot(dh, vec2(line.x, line.y)));
   if (has(kFeatureMirrors) && edge.link.x == kEdgeMirror) {
     record_event(kEventMirror, r.polygon, k, -1, -1, -1, r.t, r.o);
     r.o = vec3(place(vec2(r.o), line, push), r.o.z);
@@ -192,10 +205,18 @@ bool is_wall(int polygon, int k) {
   return has(kFeatureWalls) && edge_at(polygon, k).link.x == kEdgeWall;
 }
 
+// The ray ends on the opaque wall k of its room, `s` further on; its normal points into the room.
+void hit_wall(INOUT(Ray) r, int k, real s) {
+  finish(r, kHitWall, kEventWall, k, s);
+  vec4 line = edge_at(r.polygon, k).line;
+  r.normal = vec3(-line.x, -line.y, real(0));
+}
+
 // The ray reaches the top or bottom of the band, `s` further on.
 void leave_band(INOUT(Ray) r, real s) {
   if (has(kFeaturePeriod)) {  // z is taken modulo the period
     advance(r, s);
+    tint_ray(r, params.period_tint, r.d.z);
     r.o.z = r.d.z > real(0) ? real(0) : params.top;
   } else if (has(kFeatureFloor) && r.d.z < real(0)) {
     finish(r, kHitFloor, kEventFloor, -1, s);
@@ -316,7 +337,7 @@ void sphere_step(INOUT(Ray) r, INOUT(Relaxation) x) {
     if (wall.second < params.eps) {
       finish(r, kHitVertex, kEventVertex, -1, real(0));  // in a corner: no single edge to cross
     } else if (is_wall(r.polygon, wall.edge)) {
-      finish(r, kHitWall, kEventWall, wall.edge, real(0));
+      hit_wall(r, wall.edge, real(0));
     } else {
       cross_edge(r, wall.edge, params.offset);
       relax(x);
@@ -380,7 +401,7 @@ void segment_step(INOUT(Ray) r, INOUT(Segment) seg) {
   } else if (seg.exit.edge < 0 || seg.exit.corner) {
     finish(r, kHitVertex, kEventVertex, -1, seg.exit.edge < 0 ? real(0) : seg.exit.s);
   } else if (is_wall(r.polygon, seg.exit.edge)) {
-    finish(r, kHitWall, kEventWall, seg.exit.edge, seg.exit.s);
+    hit_wall(r, seg.exit.edge, seg.exit.s);
   } else {
     advance(r, seg.exit.s);
     cross_edge(r, seg.exit.edge, real(0));
@@ -453,6 +474,8 @@ Ray march(int polygon, vec3 from, vec3 dir) {
   r.object = -1;
   r.normal = vec3(real(0));
   r.surface = vec3(real(0));
+  r.light = vec3(real(0));
+  r.clear = real(1);
   if (has(kFeaturePeriod)) {
     r.o.z = mod(r.o.z, params.top);
   }
@@ -513,18 +536,24 @@ Ray march(int polygon, vec3 from, vec3 dir) {
 
 // ---- Appearance (DESIGN.md section 1) --------------------------------------------------------
 
-// The linear colour of a finished ray: its surface seen through `crossings` tinted walls.
+// The colour of a finished ray, linear and tone-mapped: its surface, lit and faded by distance
+// into the fog, seen through the walls it crossed; the sky or the ground where it left the band
+// or missed the rooms; the fog at the distance it reached where it failed (max_steps,
+// max_distance, vertex: no black specks; the hit AOV keeps the failure).
 vec3 shade(Ray r) {
-  vec3 surface = vec3(params.background);  // miss, escape, max_distance
+  vec3 fog = vec3(params.fog);
+  vec3 surface = fog;
   if (r.hit >= 0) {
-    surface = r.surface;
+    surface = lit(r.surface, r.normal);
   } else if (r.hit == kHitWall) {
-    surface = vec3(real(kWallGrey));
+    surface = lit(vec3(params.wall), r.normal);
   } else if (r.hit == kHitFloor) {
-    surface = vec3(floor_tone(vec2(r.o)));
-  } else if (r.hit == kHitMaxSteps || r.hit == kHitVertex) {
-    surface = vec3(real(0));  // undecided rays show as black
+    surface = lit(floor_tone(vec2(r.o)) * vec3(params.floor_colour), r.normal);
   }
-  real transmittance = pow(real(1) - params.wall_tint, real(r.crossings));
-  return through_walls(surface, transmittance, vec3(params.fog));
+  if (r.hit >= 0 || r.hit == kHitWall || r.hit == kHitFloor) {
+    surface = fogged(surface, fog, r.t, params.fog_distance);
+  } else if (r.hit == kHitEscape || r.hit == kHitMiss) {
+    surface = sky_colour(fog, vec3(params.sky), vec3(params.ground), r.d.z);
+  }
+  return tone_map(r.light + r.clear * surface);
 }

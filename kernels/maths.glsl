@@ -156,14 +156,59 @@ KINLINE real sphere_entry(vec3 oc, vec3 d, real radius) {
   return select(cc <= real(0), real(0), ahead);
 }
 
-// A surface's colour seen through walls that let `transmittance` of its light through; fog
-// makes up the rest.
-KINLINE vec3 through_walls(vec3 surface, real transmittance, vec3 fog) {
-  return transmittance * surface + (real(1) - transmittance) * fog;
+// ---- Appearance (DESIGN.md section 1) ----------------------------------------------------------
+
+// The opacity of a glued wall or mirror whose opacity at normal incidence is `base`, crossed by a
+// ray whose unit direction has the component `cosine` along the wall's normal: it grows towards
+// four times `base` at grazing incidence, so that wall planes seen edge-on read as glass.
+KINLINE real wall_opacity(real base, real cosine) {
+  real grazing = real(1) - abs(cosine);
+  return min(base * (real(1) + real(3) * grazing * grazing), real(1));
 }
 
-// The floor's colour at p: grey checks kFloorCheck wide (DESIGN.md section 1).
+// The light a ray has gathered from the walls it crossed, `clear` being the share of light the
+// walls before let through, after a wall of opacity a and colour `colour`: it mixes a of its
+// colour into what passes. (The share after it is clear * (1 - a).)
+KINLINE vec3 tint_light(vec3 light, real clear, real a, vec3 colour) {
+  return light + (clear * a) * colour;
+}
+
+// A surface of colour c and unit normal n lit by a light from above and ambient light, so that
+// walls facing different ways differ and no side is black.
+KINLINE vec3 lit(vec3 c, vec3 n) {
+  vec3 light = vec3(real(kLightX), real(kLightY), real(kLightZ));
+  return (real(kAmbient) + real(1.0f - kAmbient) * max(dot(n, light), real(0))) * c;
+}
+
+// A surface's colour at path length t, faded towards the fog: half fog at `fog_distance`.
+KINLINE vec3 fogged(vec3 surface, vec3 fog, real t, real fog_distance) {
+  real f = t / (t + fog_distance);
+  return surface + f * (fog - surface);
+}
+
+// What a ray that leaves the band or misses every room sees, by the height dz of its unit
+// direction: the fog at the horizon, growing towards the sky straight up and the ground
+// straight down.
+KINLINE vec3 sky_colour(vec3 fog, vec3 sky, vec3 ground, real dz) {
+  real k = sqrt(abs(dz));
+  return fog + k * (select(dz >= real(0), sky, ground) - fog);
+}
+
+// The floor's tone at p: checks kFloorCheck wide, 1 and kFloorDark (DESIGN.md section 1).
 KINLINE real floor_tone(vec2 p) {
   real check = floor(p.x / real(kFloorCheck)) + floor(p.y / real(kFloorCheck));
-  return select(mod(check, real(2)) >= real(1), real(kFloorDarkGrey), real(kWallGrey));
+  return select(mod(check, real(2)) >= real(1), real(kFloorDark), real(1));
+}
+
+// Linear light brought into [0, 1] for display before sRGB encoding: a filmic curve (Narkowicz's
+// fit of ACES, after an exposure of kExposure) that leaves the middle tones about where they are
+// and rolls highlights off.
+KINLINE real tone_curve(real c) {
+  real x = real(kExposure) * c;
+  return min(x * (real(2.51f) * x + real(0.03f)) / (x * (real(2.43f) * x + real(0.59f)) + real(0.14f)),
+             real(1));
+}
+
+KINLINE vec3 tone_map(vec3 c) {
+  return vec3(tone_curve(c.x), tone_curve(c.y), tone_curve(c.z));
 }

@@ -135,8 +135,10 @@ std::string baked_params(const Tables<float>::KernelParams& p) {
          std::to_string(p.max_steps) + ", " + std::to_string(p.polygon_count) + ",\n    " +
          number(p.eps) + ", " + number(p.offset) + ", " + number(p.max_distance) + ", " +
          number(p.omega) + ",\n    " + number(p.height) + ", " + number(p.top) + ", " +
-         number(p.vertex_tolerance) + ", " + number(p.normal_step) + ", " + number(p.wall_tint) +
-         ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.background) + ");\n";
+         number(p.vertex_tolerance) + ", " + number(p.normal_step) + ", " + number(p.fog_distance) +
+         ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.sky) + ", " +
+         vec4_literal(p.ground) + ", " + vec4_literal(p.wall) + ", " +
+         vec4_literal(p.floor_colour) + ", " + vec4_literal(p.period_tint) + ");\n";
 }
 
 std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays) {
@@ -145,14 +147,14 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays)
   const std::string zero4 = "vec4(0.0)", zeroi = "ivec4(0)";
   std::string s = "\n// The scene's tables, baked in.\n";
   s += array(constant_arrays, "ivec4", "polygons", tables.polygons, zeroi, ivec4_literal);
-  s +=
-      array(constant_arrays, "EdgeRecord", "edges", tables.edges,
-            "EdgeRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi + ")",
-            [](const Edge& e) {
-              return "EdgeRecord(" + vec4_literal(e.segment) + ", " + vec4_literal(e.line) + ", " +
-                     vec4_literal(e.map_linear) + ", " + vec4_literal(e.map_shift) + ", " +
-                     ivec4_literal(e.link) + ")";
-            });
+  s += array(constant_arrays, "EdgeRecord", "edges", tables.edges,
+             "EdgeRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi +
+                 ", " + zero4 + ")",
+             [](const Edge& e) {
+               return "EdgeRecord(" + vec4_literal(e.segment) + ", " + vec4_literal(e.line) + ", " +
+                      vec4_literal(e.map_linear) + ", " + vec4_literal(e.map_shift) + ", " +
+                      ivec4_literal(e.link) + ", " + vec4_literal(e.tint) + ")";
+             });
   s += array(constant_arrays, "ObjectRecord", "objects", tables.objects,
              "ObjectRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi + ")",
              [](const Object& o) {

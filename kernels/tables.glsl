@@ -11,6 +11,8 @@ struct EdgeRecord {
   vec4 map_linear;  // the gluing map's linear part, columns (x, y) and (z, w)
   vec4 map_shift;   // its translation (x, y), 0, 0
   ivec4 link;       // kind (kEdge*), destination polygon, destination edge, 0
+  vec4 tint;        // glued or mirror: the colour (xyz) a crossing mixes in, and its opacity at
+                    // normal incidence (w); a wall: 0
 };
 
 // One solid in one polygon's room.
@@ -35,7 +37,11 @@ struct KernelParams {
   real top;               // the period of a translation prism, else the height
   real vertex_tolerance;  // analytic: an exit this close to a vertex meets the vertex
   real normal_step;       // step of the finite differences that give object normals
-  real wall_tint;
-  vec4 fog;
-  vec4 background;
+  real fog_distance;       // path length at which a surface is half fog
+  vec4 fog;               // the look (DESIGN.md section 1), linear RGB (xyz)
+  vec4 sky;
+  vec4 ground;
+  vec4 wall;
+  vec4 floor_colour;
+  vec4 period_tint;  // a translation prism's floor and ceiling, glued: as an edge's tint
 };

@@ -87,4 +87,10 @@ Frame read_aov_exr(const std::filesystem::path& exr) {
   return frame;
 }
 
+Png read_png(const std::filesystem::path& png) {
+  Png image;
+  image_library().read_png(png.string(), image.rgb, image.width, image.height);
+  return image;
+}
+
 }  // namespace flatmarch

@@ -3,7 +3,9 @@
 // first use: image_library.hpp).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include "backends/backend.hpp"
 
@@ -18,5 +20,12 @@ void write_aov_exr(const Frame& frame, const std::filesystem::path& exr);
 
 // Reads an EXR written by write_aov_exr back into a frame.
 Frame read_aov_exr(const std::filesystem::path& exr);
+
+// A PNG's colour as written: 8-bit sRGB, 3 bytes a pixel, rows from the top.
+struct Png {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+Png read_png(const std::filesystem::path& png);
 
 }  // namespace flatmarch

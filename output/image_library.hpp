@@ -6,7 +6,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "backends/backend.hpp"
 
@@ -28,11 +30,14 @@ struct ImageLibrary {
   void (*write_aov_exr)(const Frame& frame, const std::string& path) = nullptr;
   // An EXR written by write_aov_exr, into `frame` (resized).
   void (*read_aov_exr)(const std::string& path, Frame& frame) = nullptr;
+  // A PNG's colour as written, 8-bit sRGB, 3 bytes a pixel (rows from the top).
+  void (*read_png)(const std::string& path, std::vector<uint8_t>& rgb, int& width,
+                   int& height) = nullptr;
   ColourComparison (*compare)(const Frame& a, const Frame& b, float fail, float warn) = nullptr;
 };
 
 // Changes whenever ImageLibrary or a type it passes changes.
-constexpr int kImageLibraryAbi = 1;
+constexpr int kImageLibraryAbi = 2;
 
 // The module, loaded on first call from FLATMARCH_MODULE_DIR (environment), the build's module
 // folder, or ../lib beside the program; throws std::runtime_error saying where it looked and why

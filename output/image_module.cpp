@@ -74,6 +74,19 @@ void read_aov_exr(const std::string& exr, Frame& frame) {
     }
 }
 
+void read_png(const std::string& png, std::vector<uint8_t>& rgb, int& width, int& height) {
+  OIIO::ImageBuf buf(png);
+  check(buf.read(0, 0, true, OIIO::TypeDesc::UINT8), buf, png, "read");
+  const OIIO::ImageSpec& spec = buf.spec();
+  if (spec.nchannels < 3) throw std::runtime_error(png + ": not an RGB image");
+  width = spec.width;
+  height = spec.height;
+  rgb.resize(3 * static_cast<size_t>(width) * static_cast<size_t>(height));
+  check(
+      buf.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, 3), OIIO::TypeDesc::UINT8, rgb.data()),
+      buf, png, "read the pixels of");
+}
+
 OIIO::ImageBuf colour_image(const Frame& f) {
   OIIO::ImageBuf image(OIIO::ImageSpec(f.width, f.height, 3, OIIO::TypeDesc::FLOAT));
   image.set_pixels(OIIO::ROI(0, f.width, 0, f.height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
@@ -103,6 +116,7 @@ const ImageLibrary kLibrary{.abi = kImageLibraryAbi,
                             .write_png = write_png,
                             .write_aov_exr = write_aov_exr,
                             .read_aov_exr = read_aov_exr,
+                            .read_png = read_png,
                             .compare = compare};
 
 }  // namespace

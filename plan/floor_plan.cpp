@@ -13,11 +13,8 @@ namespace flatmarch {
 
 namespace {
 
-// Colours of glued edge pairs (Tableau 10 without its pink, which the light ray uses). Beyond
-// ten gluings the colours repeat with a dash pattern.
-constexpr std::array<const char*, 10> kGluingColours{"#4e79a7", "#f28e2b", "#59a14f", "#e15759",
-                                                     "#76b7b2", "#edc948", "#b07aa1", "#17becf",
-                                                     "#9c755f", "#bab0ac"};
+// Glued edge pairs are drawn in their gluing's colour (the scene's look: the colour the rooms
+// tint crossing rays with). Beyond the palette's colours they repeat with a dash pattern.
 constexpr std::array<const char*, 4> kDashes{"", "9 4", "3 3", "12 3 3 3"};
 constexpr std::array<const char*, 8> kConeColours{"#1b1b1b", "#7f3c8d", "#11a579", "#3969ac",
                                                   "#f2b701", "#e73f74", "#80ba5a", "#e68310"};
@@ -25,15 +22,6 @@ constexpr const char* kRayColour = "#d81b60";
 constexpr const char* kMirrorColour = "#9bb7c9";
 constexpr const char* kWallColour = "#3d3d3d";
 constexpr const char* kObjectColour = "#6a3d9a";
-
-std::string rgb(Vec3 c) {
-  char buf[8];
-  const auto byte = [](double v) {
-    return static_cast<int>(std::lround(255.0 * std::clamp(v, 0.0, 1.0)));
-  };
-  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", byte(c.x), byte(c.y), byte(c.z));
-  return buf;
-}
 
 // Writes numbers with two decimals: pixels need no more.
 class Svg {
@@ -133,14 +121,16 @@ void draw_edges(Svg& svg, const Scene& scene, const PlanLayout& layout) {
         line("edge mirror-core", "#ffffff", 1.5, "");
       } else {
         const size_t k = static_cast<size_t>(e.gluing);
-        const char* colour = kGluingColours[k % kGluingColours.size()];
-        line("edge glued", colour, 4.0, kDashes[(k / kGluingColours.size()) % kDashes.size()]);
+        const std::string colour = hex_from_linear(scene.look.gluing_colour(e.gluing));
+        const size_t palette = gluing_palette().size();
+        line("edge glued", colour, 4.0,
+             k < scene.look.gluings.size() ? "" : kDashes[(k / palette) % kDashes.size()]);
         // Arrows that correspond under the map: A -> B on edge a; on edge b (C -> D) the images,
         // D -> C for orientation-preserving maps and C -> D for reversing ones.
         const Gluing& g = scene.gluings[k];
         const bool is_a = g.a == EdgeRef{static_cast<int>(p), i};
         const bool along = is_a || g.g.determinant() < 0.0;
-        draw_arrow(svg, along ? a : b, along ? b : a, colour);
+        draw_arrow(svg, along ? a : b, along ? b : a, colour.c_str());
         const Vec2 label = 0.5 * (a + b) - 13.0 * glm::normalize(perp(b - a));
         svg << "<text class=\"gluing-label\" x=\"" << label.x << "\" y=\"" << label.y + 4.0
             << "\" font-size=\"11\" fill=\"" << colour << "\" text-anchor=\"middle\">"
@@ -194,7 +184,7 @@ void draw_objects(Svg& svg, const Scene& scene, const PlanLayout& layout) {
   for (size_t k = 0; k < scene.objects.size(); ++k) {
     const Object& o = scene.objects[k];
     const Vec2 c = layout.to_pixels(Vec2(o.center));
-    const std::string colour = o.color ? rgb(*o.color) : kObjectColour;
+    const std::string colour = o.color ? hex_from_linear(*o.color) : kObjectColour;
     const std::string style = "\" fill=\"" + colour + "\" fill-opacity=\"0.45\" stroke=\"" +
                               colour + "\" stroke-width=\"1.5\"";
     const auto rect = [&](Vec2 half) {

@@ -335,14 +335,29 @@ void read_camera(const JsonNode& root, Scene& scene) {
 void read_look(const JsonNode& root, Scene& scene) {
   if (!root.has("look")) return;
   const JsonNode node = root["look"];
-  node.allow_keys({"wall_tint", "fog", "background"});
+  if (node.has("background"))
+    node["background"].fail(
+        "the background is now a gradient: give \"sky\" (straight up) and "
+        "\"ground\" (straight down); the horizon takes \"fog\"");
+  node.allow_keys(
+      {"wall_tint", "fog", "fog_distance", "sky", "ground", "wall", "floor", "mirror", "gluings"});
+  Look& look = scene.look;
   if (node.has("wall_tint")) {
-    scene.look.wall_tint = node["wall_tint"].number();
-    if (scene.look.wall_tint < 0.0 || scene.look.wall_tint > 1.0)
+    look.wall_tint = node["wall_tint"].number();
+    if (look.wall_tint < 0.0 || look.wall_tint > 1.0)
       node["wall_tint"].fail("wall_tint lies in [0, 1]");
   }
-  if (node.has("fog")) scene.look.fog = node["fog"].color();
-  if (node.has("background")) scene.look.background = node["background"].color();
+  if (node.has("fog_distance")) look.fog_distance = node["fog_distance"].positive();
+  const std::pair<const char*, Vec3*> colours[] = {
+      {"fog", &look.fog},   {"sky", &look.sky},     {"ground", &look.ground},
+      {"wall", &look.wall}, {"floor", &look.floor}, {"mirror", &look.mirror}};
+  for (const auto& [key, colour] : colours)
+    if (node.has(key)) *colour = node[key].color();
+  if (node.has("gluings")) {
+    const JsonNode list = node["gluings"];
+    const size_t n = list.array_size(0, scene.gluings.size());
+    for (size_t k = 0; k < n; ++k) look.gluings.push_back(list[k].color());
+  }
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
 #include "scene/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace flatmarch {
 
@@ -43,6 +46,41 @@ double Object::z_max() const {
       return z1;
   }
   return 0.0;
+}
+
+const std::vector<const char*>& gluing_palette() {
+  static const std::vector<const char*> palette{"#4e79a7", "#f28e2b", "#59a14f", "#e15759",
+                                                "#76b7b2", "#edc948", "#b07aa1", "#17becf",
+                                                "#9c755f", "#bab0ac"};
+  return palette;
+}
+
+Vec3 linear_from_hex(const char* hex) {
+  const unsigned long rgb = std::strtoul(hex + 1, nullptr, 16);
+  Vec3 c;
+  for (int i = 0; i < 3; ++i) {
+    const double v = static_cast<double>((rgb >> (8 * (2 - i))) & 0xffu) / 255.0;
+    c[i] = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+  }
+  return c;
+}
+
+std::string hex_from_linear(Vec3 c) {
+  int byte[3];
+  for (int i = 0; i < 3; ++i) {
+    const double v = std::clamp(c[i], 0.0, 1.0);
+    const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+    byte[i] = static_cast<int>(std::lround(255.0 * e));
+  }
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", byte[0], byte[1], byte[2]);
+  return buf;
+}
+
+Vec3 Look::gluing_colour(int k) const {
+  if (k >= 0 && k < static_cast<int>(gluings.size())) return gluings[static_cast<size_t>(k)];
+  const auto& palette = gluing_palette();
+  return kPaletteShade * linear_from_hex(palette[static_cast<size_t>(k) % palette.size()]);
 }
 
 int Scene::marker_at(int polygon, int vertex) const {

@@ -134,11 +134,36 @@ struct Camera {
   double fov_deg = 75.0;
 };
 
+// How the rooms look (DESIGN.md section 1, "Appearance"), every colour linear RGB in [0, 1]. The
+// defaults are chosen so that every gallery scene reads well: walls visible, the horizon a dark
+// band between a light sky and a darker ground.
 struct Look {
+  // Opacity of a glued wall or a mirror crossed at normal incidence; about four times it at
+  // grazing incidence. Each crossing takes that share of the light and gives its colour.
   double wall_tint = 0.05;
-  Vec3 fog{0.5, 0.6, 0.7};
-  Vec3 background{1.0, 1.0, 1.0};
+  Vec3 fog{0.035, 0.04, 0.05};     // what distance fades towards; the horizon
+  double fog_distance = 15.0;      // path length at which a surface is half fog
+  Vec3 sky{0.4, 0.5, 0.65};        // straight up, above the band; towards the horizon, the fog
+  Vec3 ground{0.06, 0.055, 0.05};  // straight down, below it
+  Vec3 wall{0.55, 0.55, 0.55};     // opaque walls, lit
+  Vec3 floor{0.55, 0.55, 0.55};    // the floor's light checks, lit (the dark ones are darker)
+  Vec3 mirror{0.3, 0.35, 0.45};    // a mirror's tint: a dark, bluish silver
+  // A colour per gluing, in the scene's gluing order; gluings beyond these take the palette's
+  // at kPaletteShade of its light (the colours mix into what rays see, and far enough away
+  // into the horizon: full-strength colours would wash it out).
+  std::vector<Vec3> gluings;
+  static constexpr double kPaletteShade = 0.4;
+
+  // The colour of gluing k (the floor plan draws the pair in it).
+  Vec3 gluing_colour(int k) const;
 };
+
+// The palette glued pairs take by default, in sRGB as the floor plan writes it (Tableau 10
+// without its pink, which the floor plan's light ray uses).
+const std::vector<const char*>& gluing_palette();
+// An sRGB "#rrggbb" colour as linear RGB, and back (IEC 61966-2-1, rounded to 8 bits).
+Vec3 linear_from_hex(const char* hex);
+std::string hex_from_linear(Vec3 c);
 
 struct Scene {
   std::string name;

@@ -9,8 +9,10 @@
 #include <set>
 
 #include "backends/oracle/oracle.hpp"
+#include "output/image_io.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
+#include "tests/process.hpp"
 
 namespace flatmarch {
 namespace {
@@ -101,6 +103,40 @@ TEST_P(GalleryScene, CameraShowsAnObjectAndMore) {
   std::set<float> codes(f.hit.begin(), f.hit.end());
   EXPECT_GE(codes.size(), 2u) << "every pixel ends the same way";
   EXPECT_GE(*codes.rbegin(), 0.0f) << "no object in sight";
+}
+
+// What a person sees (issue 20): `flatmarch render` of the scene as a new user runs it (320x180,
+// its default method, analytic), read back from the PNG. Its middle third of rows, where the
+// horizon and the walls are, is neither washed out nor murky (mean luminance within 0.25-0.75 of
+// white) and has contrast (standard deviation at least 0.08: walls, the horizon, objects), and
+// no pixel is black: rays that failed are shaded as fog, and no scene of the gallery has a black
+// surface. Luminance: Rec. 709 weights of the sRGB values, as an image viewer shows them.
+TEST_P(GalleryScene, ReadsWellAsANewUserRendersIt) {
+  const fs::path file = GetParam();
+  const std::string png = testing::TempDir() + "/reads_well_" + file.stem().string() + ".png";
+  const auto r = test::run_flatmarch({"render", file.string(), "-o", png, "--size", "320x180"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("/analytic"), std::string::npos) << r.err;
+  const Png image = read_png(png);
+  ASSERT_EQ(image.width, 320);
+  ASSERT_EQ(image.height, 180);
+  double sum = 0.0, sum2 = 0.0;
+  int n = 0, black = 0;
+  for (int j = 0; j < image.height; ++j)
+    for (int i = 0; i < image.width; ++i) {
+      const uint8_t* p = &image.rgb[3 * (static_cast<size_t>(j) * 320 + static_cast<size_t>(i))];
+      if (std::max({p[0], p[1], p[2]}) < 8) ++black;
+      if (j < image.height / 3 || j >= 2 * image.height / 3) continue;
+      const double y = (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) / 255.0;
+      sum += y;
+      sum2 += y * y;
+      ++n;
+    }
+  const double mean = sum / n, sd = std::sqrt(std::max(sum2 / n - mean * mean, 0.0));
+  EXPECT_GE(mean, 0.25) << "the middle third is murky";
+  EXPECT_LE(mean, 0.75) << "the middle third is washed out";
+  EXPECT_GE(sd, 0.08) << "the middle third has no contrast (mean " << mean << ")";
+  EXPECT_EQ(black, 0) << "black pixels";
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, GalleryScene, testing::ValuesIn(test::gallery_files()),

@@ -386,9 +386,21 @@ TEST(Camera, RaysOfDesignSection2) {
   expect_near(camera_ray(c, 0, 0, 4, 2), glm::normalize(Vec3(1, 1.5, 0.5)));
 }
 
+// DESIGN.md section 1 (Appearance), by hand: the sky gradient seen along a direction rising dz,
+// through the display curve (an exposure of 0.8, then Narkowicz's fit of ACES).
+double display(double linear) {
+  const double x = 0.8 * linear;
+  return std::min(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 1.0);
+}
+Vec3 sky_seen(const Look& look, double dz) {
+  const Vec3 c = look.fog + std::sqrt(dz) * (look.sky - look.fog);
+  return {display(c.x), display(c.y), display(c.z)};
+}
+
 TEST(OracleRender, LookingStraightUpEverythingEscapes) {
   // From the centre of the 4x4 torus at z = 1 looking up with a 60 degree field of view, every
-  // ray reaches z = 2 within 1 of its start horizontally: one step, no crossing, escape.
+  // ray reaches z = 2 within 1 of its start horizontally: one step, no crossing, escape, and the
+  // sky's colour at its height.
   const Scene s = load(test::torus_json());
   Camera cam{0, {2, 2, 1}, 0.0, 90.0, 60.0};
   const Frame f = OracleBackend().render(s, cam, 8, 6, {}, {});
@@ -399,9 +411,10 @@ TEST(OracleRender, LookingStraightUpEverythingEscapes) {
       EXPECT_EQ(f.hit[px], kHitEscape);
       EXPECT_EQ(f.steps[px], 1);
       EXPECT_EQ(f.crossings[px], 0);
-      EXPECT_FLOAT_EQ(f.t[px], static_cast<float>(1.0 / camera_ray(basis, i, j, 8, 6).z));
-      for (int k = 0; k < 3; ++k)
-        EXPECT_FLOAT_EQ(f.rgb[3 * px + static_cast<size_t>(k)], 1.0f);  // background
+      const Vec3 d = camera_ray(basis, i, j, 8, 6);
+      EXPECT_FLOAT_EQ(f.t[px], static_cast<float>(1.0 / d.z));
+      const Vec3 sky = sky_seen(s.look, d.z);
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(f.rgb[3 * px + static_cast<size_t>(k)], sky[k], 1e-6);
     }
 }
 

@@ -150,6 +150,7 @@ class Tracer {
     if (band == first) {
       if (scene_.period) {  // z is taken modulo the period
         advance(band);
+        tint(kernel::period_tint(scene_), d_.z, t_);
         o_.z = d_.z > 0.0 ? 0.0 : *scene_.period;
         return false;
       }
@@ -166,6 +167,7 @@ class Tracer {
       case EdgeKind::wall:
         return finish(EventKind::wall, kHitWall, exit.s, exit.edge, Vec3(-edge.normal, 0.0));
       case EdgeKind::mirror: {
+        tint(edge, dh, t_ + exit.s);
         record({.kind = EventKind::mirror,
                 .polygon = p_,
                 .edge = exit.edge,
@@ -177,6 +179,7 @@ class Tracer {
         break;
       }
       case EdgeKind::glued: {
+        tint(edge, dh, t_ + exit.s);
         record({.kind = EventKind::gluing,
                 .polygon = p_,
                 .edge = exit.edge,
@@ -197,6 +200,21 @@ class Tracer {
     return false;
   }
 
+  // The glued wall or mirror `edge`, met at path length t, tints what lies beyond it (the
+  // kernel's cross_edge).
+  void tint(const Edge& edge, Vec2 dh, double t) {
+    tint(kernel::edge_tint(scene_.look, edge), glm::dot(dh, edge.normal), t);
+  }
+
+  // ... and likewise any glued plane of that tint, crossed with `cosine` along its normal.
+  void tint(glm::dvec4 tint, double cosine, double t) {
+    RayEnd& end = out_.end;
+    const double a = maths_.wall_opacity(tint.w, cosine);
+    const Vec3 colour = maths_.fogged(Vec3(tint), scene_.look.fog, t, scene_.look.fog_distance);
+    end.light = maths_.tint_light(end.light, end.clear, a, colour);
+    end.clear *= 1.0 - a;
+  }
+
   void advance(double s) {
     add_path(o_ + s * d_);
     o_ += s * d_;
@@ -210,6 +228,7 @@ class Tracer {
     end.t = t_;
     end.polygon = p_;
     end.at = o_;
+    end.dir = d_;
     end.normal = normal;
     record({.kind = kind,
             .polygon = p_,
@@ -223,6 +242,7 @@ class Tracer {
   void miss(double s) {
     out_.end.hit = kHitMiss;
     out_.end.t = s;
+    out_.end.dir = d_;
     record({.kind = EventKind::miss, .polygon = -1, .t = s, .at = o_ + s * d_});
   }
 
@@ -239,6 +259,7 @@ class Tracer {
   const MarchParams& params_;
   const OracleOptions& options_;
   OracleResult& out_;
+  kernel::Kernel<double, 0u> maths_;  // the kernel's appearance maths
   int p_ = 0;
   Vec3 o_{0.0}, d_{0.0};
   double t_ = 0.0;
@@ -282,8 +303,12 @@ Vec3 oracle_color(const Scene& scene, const RayEnd& end) {
   Shader::Ray r{};
   r.hit = end.hit;
   r.crossings = end.crossings;
+  r.t = end.t;
   r.o = end.at;
+  r.d = end.dir;
   r.normal = end.normal;
+  r.light = end.light;
+  r.clear = end.clear;
   if (end.hit >= 0) {
     const Object* object = end.hit < static_cast<int>(scene.objects.size())
                                ? &scene.objects[static_cast<size_t>(end.hit)]

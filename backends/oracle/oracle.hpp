@@ -18,8 +18,11 @@ struct RayEnd {
   int steps = 0;
   double t = 0.0;
   int polygon = 0;
-  Vec3 at{0.0};      // end point in `polygon`'s frame
-  Vec3 normal{0.0};  // surface normal there (objects)
+  Vec3 at{0.0};        // end point in `polygon`'s frame
+  Vec3 dir{0.0};       // unit direction there
+  Vec3 normal{0.0};    // surface normal there (objects, walls, the floor)
+  Vec3 light{0.0};     // what the glued walls and mirrors crossed give (the kernel's Ray.light)
+  double clear = 1.0;  // the share of light beyond them they let through
 };
 
 // The straight piece of a ray's path inside one room, for floor plans.

@@ -80,8 +80,10 @@ struct Packet {
   V t;
   VI steps, crossings, hit;
   M done;
-  V nx, ny, nz;  // normal of the solid hit
+  V nx, ny, nz;  // normal of the solid, wall or floor hit
   V sr, sg, sb;  // colour of the solid hit
+  V lr, lg, lb;  // what the walls crossed give (march.glsl's Ray.light)
+  V clear;       // the share of light beyond them they let through
 };
 
 // The rays of `m` go on from (px, py) (their height unchanged) along (hx, hy, hz): where a
@@ -92,6 +94,13 @@ HWY_INLINE void MoveTo(Packet& r, M m, V px, V py, V hx, V hy, V hz) {
   r.dx = Select(m, hx, r.dx);
   r.dy = Select(m, hy, r.dy);
   r.dz = Select(m, hz, r.dz);
+}
+
+// The rays of `m` end on a surface of unit normal (nx, ny, nz).
+HWY_INLINE void SetNormal(Packet& r, M m, V nx, V ny, V nz) {
+  r.nx = Select(m, nx, r.nx);
+  r.ny = Select(m, ny, r.ny);
+  r.nz = Select(m, nz, r.nz);
 }
 
 struct WallDistance {

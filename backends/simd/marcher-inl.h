@@ -55,7 +55,7 @@ class Marcher {
   static void clear(Packet& r, Relaxation& x, Segment& seg) {
     r.polygon = r.steps = r.crossings = r.hit = SplatI(0);
     r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = r.t = Splat(0.0f);
-    r.nx = r.ny = r.nz = r.sr = r.sg = r.sb = Splat(0.0f);
+    r.nx = r.ny = r.nz = r.sr = r.sg = r.sb = r.lr = r.lg = r.lb = r.clear = Splat(0.0f);
     r.done = hn::Not(None());
     x.omega = x.last_radius = x.last_step = Splat(0.0f);
     seg.known = seg.exit.corner = None();
@@ -76,8 +76,12 @@ class Marcher {
     r.crossings = Select(m, SplatI(0), r.crossings);
     r.hit = Select(m, SplatI(kHitMaxSteps), r.hit);
     r.done = hn::AndNot(m, r.done);
-    // The normal and surface colour are left: only a ray that hits a solid reads them, and the
-    // hit sets them.
+    r.lr = hn::IfThenZeroElse(m, r.lr);
+    r.lg = hn::IfThenZeroElse(m, r.lg);
+    r.lb = hn::IfThenZeroElse(m, r.lb);
+    r.clear = Select(m, Splat(1.0f), r.clear);
+    // The normal and surface colour are left: only a ray that hits a solid, a wall or the floor
+    // reads them, and the hit sets them.
     if (has(kFeaturePeriod)) {
       r.oz = Select(m, lane::mod(r.oz, params_.top).v, r.oz);
     } else {
@@ -194,6 +198,7 @@ class Marcher {
       left = hn::AndNot(mk, left);
       const EdgeRecord& e = edges_[polygons_[polygon].x + k];
       const lane::vec2 o(r.ox, r.oy), d(r.dx, r.dy);
+      Tint(r, mk, params_, lane::Broadcast(e.tint), lane::dot(d, lane::vec2(e.line.x, e.line.y)));
       lane::vec2 p = o, h = d;
       V hz = r.dz;
       if (has(kFeatureMirrors) && e.link.x == kEdgeMirror) {
@@ -225,15 +230,24 @@ class Marcher {
   FLATMARCH_PACKET_INLINE void leave_band(Packet& r, M m, V s) const {
     if (has(kFeaturePeriod)) {
       advance(r, m, s);
+      Tint(r, m, params_, lane::Broadcast(params_.period_tint), r.dz);
       r.oz = Select(m, Select(r.dz > Splat(0.0f), Splat(0.0f), Splat(params_.top)), r.oz);
     } else if (has(kFeatureFloor)) {
       const M down = hn::And(m, r.dz < Splat(0.0f));
       finish(r, down, SplatI(kHitFloor), kEventFloor, SplatI(-1), s);
-      r.nz = Select(down, Splat(1.0f), r.nz);
+      SetNormal(r, down, Splat(0.0f), Splat(0.0f), Splat(1.0f));
       finish(r, hn::AndNot(down, m), SplatI(kHitEscape), kEventEscape, SplatI(-1), s);
     } else {
       finish(r, m, SplatI(kHitEscape), kEventEscape, SplatI(-1), s);
     }
+  }
+
+  // The rays of `m` end on their room's opaque wall `edge`, `s` further on.
+  FLATMARCH_PACKET_INLINE void hit_wall(Packet& r, M m, const Rooms& rooms, VI edge, V s) const {
+    if (!Any(m)) return;
+    finish(r, m, SplatI(kHitWall), kEventWall, edge, s);
+    const lane::vec2 n = walls_.wall_normal(m, rooms, edge);
+    SetNormal(r, m, n.x.v, n.y.v, Splat(0.0f));
   }
 
   // The rays of `m` hit their `object` (an index in the object table) where they are.
@@ -292,7 +306,7 @@ class Marcher {
       const M corner = hn::And(near, wall.second < eps);
       finish(r, corner, SplatI(kHitVertex), kEventVertex, SplatI(-1), Splat(0.0f));
       const M walls = hn::AndNot(corner, hn::And(near, walls_.is_wall(rooms, wall.edge)));
-      finish(r, walls, SplatI(kHitWall), kEventWall, wall.edge, Splat(0.0f));
+      hit_wall(r, walls, rooms, wall.edge, Splat(0.0f));
       const M cross = hn::AndNot(hn::Or(corner, walls), near);
       if (Any(cross)) {
         cross_edge(r, cross, wall.edge, Splat(params_.offset));
@@ -373,7 +387,7 @@ class Marcher {
            hn::IfThenZeroElse(no_edge, seg.exit.s));
     rest = hn::AndNot(vertex, rest);
     const M wall = hn::And(rest, walls_.is_wall(rooms, seg.exit.edge));
-    finish(r, wall, SplatI(kHitWall), kEventWall, seg.exit.edge, seg.exit.s);
+    hit_wall(r, wall, rooms, seg.exit.edge, seg.exit.s);
     rest = hn::AndNot(wall, rest);
     if (Any(rest)) {
       advance(r, rest, seg.exit.s);
@@ -400,7 +414,7 @@ class Marcher {
       if (has(kFeatureFloor)) {  // the underside of the floor
         const M under = hn::AndNot(above, in);
         finish(r, under, SplatI(kHitFloor), kEventFloor, SplatI(-1), s);
-        r.nz = Select(under, Splat(-1.0f), r.nz);
+        SetNormal(r, under, Splat(0.0f), Splat(0.0f), Splat(-1.0f));
         enter = hn::AndNot(under, in);
       }
       advance(r, enter, s);

@@ -27,46 +27,33 @@ HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
 
-// march.glsl's shade(): the linear colour of finished rays. transmittance[c] is
-// (1 - wall_tint)^c as shade computes it, for the first crossing counts.
-HWY_INLINE void Shade(const KernelParams& params, const Packet& r,
-                      const std::vector<float>& transmittance, V& red, V& green, V& blue) {
-  V cr = Splat(params.background.x), cg = Splat(params.background.y);
-  V cb = Splat(params.background.z);
+// march.glsl's shade(): the colour of finished rays, linear and tone-mapped.
+HWY_INLINE void Shade(const KernelParams& params, const Packet& r, V& red, V& green, V& blue) {
+  const lane::vec3 fog(lane::Broadcast(params.fog));
+  lane::vec3 surface = fog;
+  const lane::vec3 normal(r.nx, r.ny, r.nz);
   const M object = AtLeastZero(r.hit);
-  cr = Select(object, r.sr, cr);
-  cg = Select(object, r.sg, cg);
-  cb = Select(object, r.sb, cb);
   const M wall = Equal(r.hit, kHitWall);
-  const V grey = Splat(kWallGrey);
-  cr = Select(wall, grey, cr);
-  cg = Select(wall, grey, cg);
-  cb = Select(wall, grey, cb);
   const M floor = Equal(r.hit, kHitFloor);
-  if (Any(floor)) {
-    const V tone = lane::floor_tone(lane::vec2(r.ox, r.oy)).v;
-    cr = Select(floor, tone, cr);
-    cg = Select(floor, tone, cg);
-    cb = Select(floor, tone, cb);
+  const M solid = hn::Or(object, hn::Or(wall, floor));
+  if (Any(solid)) {
+    lane::vec3 colour = lane::vec3(r.sr, r.sg, r.sb);
+    colour = lane::select(lane::lane_bool{wall}, lane::vec3(lane::Broadcast(params.wall)), colour);
+    if (Any(floor)) {
+      const lane::vec3 tiles = lane::floor_tone(lane::vec2(r.ox, r.oy)) *
+                               lane::vec3(lane::Broadcast(params.floor_colour));
+      colour = lane::select(lane::lane_bool{floor}, tiles, colour);
+    }
+    const lane::vec3 seen = lane::fogged(lane::lit(colour, normal), fog, r.t, params.fog_distance);
+    surface = lane::select(lane::lane_bool{solid}, seen, surface);
   }
-  const M black = hn::Or(Equal(r.hit, kHitMaxSteps), Equal(r.hit, kHitVertex));
-  cr = hn::IfThenZeroElse(black, cr);
-  cg = hn::IfThenZeroElse(black, cg);
-  cb = hn::IfThenZeroElse(black, cb);
-  const int last = static_cast<int>(transmittance.size()) - 1;
-  V tr = hn::GatherIndex(D(), transmittance.data(), hn::Min(r.crossings, SplatI(last)));
-  if (!hn::AllFalse(DI(), r.crossings > SplatI(last))) {  // beyond the table
-    std::array<int32_t, hn::MaxLanes(DI())> crossings{};
-    std::array<float, hn::MaxLanes(D())> factor{};
-    hn::StoreU(r.crossings, DI(), crossings.data());
-    hn::StoreU(tr, D(), factor.data());
-    for (size_t l = 0; l < hn::Lanes(D()); ++l)
-      if (crossings[l] > last)
-        factor[l] = glm::pow(1.0f - params.wall_tint, static_cast<float>(crossings[l]));
-    tr = hn::LoadU(D(), factor.data());
+  const M open = hn::Or(Equal(r.hit, kHitEscape), Equal(r.hit, kHitMiss));
+  if (Any(open)) {
+    const lane::vec3 sky = lane::sky_colour(fog, lane::vec3(lane::Broadcast(params.sky)),
+                                            lane::vec3(lane::Broadcast(params.ground)), r.dz);
+    surface = lane::select(lane::lane_bool{open}, sky, surface);
   }
-  const lane::vec3 c =
-      lane::through_walls(lane::vec3(cr, cg, cb), tr, lane::vec3(lane::Broadcast(params.fog)));
+  const lane::vec3 c = lane::tone_map(lane::vec3(r.lr, r.lg, r.lb) + lane::real(r.clear) * surface);
   red = c.x.v;
   green = c.y.v;
   blue = c.z.v;
@@ -212,7 +199,7 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       waited = 0;
       // Write out the rays that have ended, then give their lanes the next pixels.
       V cr, cg, cb;
-      Shade(job.tables->params, r, job.transmittance, cr, cg, cb);
+      Shade(job.tables->params, r, cr, cg, cb);
       hn::StoreU(cr, D(), red.data());
       hn::StoreU(cg, D(), green.data());
       hn::StoreU(cb, D(), blue.data());

@@ -22,9 +22,6 @@ struct PacketJob {
   // Per edge of tables->edges, what the packets would otherwise recompute per step: b - a (x, y),
   // the vertex tolerance in units of the edge parameter (z), a.y + (b - a).y (w).
   std::vector<glm::vec4> edge_extra;
-  // transmittance[c] = (1 - wall_tint)^c for c crossings, c <= max_steps, as the kernel's
-  // shade computes it.
-  std::vector<float> transmittance;
 
   // A frame: pixels [0, width) x [0, height) seen from `camera`.
   CameraBasis<float> basis{};

@@ -26,19 +26,11 @@ namespace {
 constexpr std::array<std::pair<const char*, int64_t>, 3> kIsas{
     {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4}}};
 
-// Entries of the transmittance table (per crossing count); rays with more crossings are rare
-// and shaded one by one.
-constexpr int kTransmittanceTable = 4096;
-
 }  // namespace
 
 PacketJob frame_job(const kernel::SceneTables<float>& tables, const Camera& camera, int width,
                     int height, Frame& frame) {
   PacketJob job = packet_job(tables);
-  // As the kernel's shade computes it, in f32.
-  const int size = std::min(tables.params.max_steps, kTransmittanceTable) + 1;
-  const float clear = 1.0f - tables.params.wall_tint;
-  for (int c = 0; c < size; ++c) job.transmittance.push_back(glm::pow(clear, float(c)));
   job.basis = camera_basis<float>(float(camera.yaw_deg), float(camera.pitch_deg),
                                   float(camera.fov_deg), width, height);
   job.polygon = camera.polygon;

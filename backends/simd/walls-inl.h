@@ -26,6 +26,20 @@ HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
 
+// The rays of `m` cross a glued wall or mirror of tint `tint` (the edge table's) whose outward
+// unit normal is n: march.glsl's cross_edge mixes its colour, fogged, into what they see.
+HWY_INLINE void Tint(Packet& r, M m, const KernelParams& params, const lane::vec4& tint,
+                     lane::real cosine) {
+  const lane::real a = lane::wall_opacity(tint.w, cosine);
+  const lane::vec3 colour = lane::fogged(lane::vec3(tint), lane::vec3(lane::Broadcast(params.fog)),
+                                         r.t, params.fog_distance);
+  const lane::vec3 light = lane::tint_light(lane::vec3(r.lr, r.lg, r.lb), r.clear, a, colour);
+  r.lr = Select(m, light.x.v, r.lr);
+  r.lg = Select(m, light.y.v, r.lg);
+  r.lb = Select(m, light.z.v, r.lb);
+  r.clear = Select(m, (lane::real(r.clear) * (lane::real(1.0f) - a)).v, r.clear);
+}
+
 class Walls {
  public:
   Walls(const kernel::SceneTables<float>& tables, const std::vector<glm::vec4>& edge_extra)
@@ -71,7 +85,13 @@ class Walls {
                                                 edge.map_linear.w,
                                                 to.x,
                                                 to.y,
-                                                to.z};
+                                                to.z,
+                                                edge.line.x,
+                                                edge.line.y,
+                                                edge.tint.x,
+                                                edge.tint.y,
+                                                edge.tint.z,
+                                                edge.tint.w};
       for (size_t f = 0; f < kGlueFields; ++f) glue_[f][e] = glue[f];
       to_polygon_[e] = link.x == kEdgeGlued ? link.y : 0;
     }
@@ -220,6 +240,22 @@ class Walls {
     return wall;
   }
 
+  // The inward unit normal of each lane's opaque wall `edge` of its room (for the rays of `m`).
+  FLATMARCH_PACKET_INLINE lane::vec2 wall_normal(M m, const Rooms& rooms, VI edge) const {
+    V nx = Splat(0.0f), ny = Splat(0.0f);
+    for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
+      const ivec4 poly = polygons_[rooms.polygon[i]];
+      for (int k = 0; k < poly.y; ++k) {
+        const EdgeRecord& e = edges_[poly.x + k];
+        if (e.link.x != kEdgeWall) continue;
+        const M at = hn::And(m, hn::And(rooms.lanes[i], Equal(edge, k)));
+        nx = Select(at, Splat(-e.line.x), nx);
+        ny = Select(at, Splat(-e.line.y), ny);
+      }
+    }
+    return {nx, ny};
+  }
+
   // The rays of `m` go through their edge `edge` (of their room, glued) into the glued room and
   // are placed `push` inside the edge they are then behind: march.glsl's cross_edge when every
   // edge is glued and the scene's edges fit in a vector (merge()), each lane looking its edge's
@@ -232,6 +268,8 @@ class Walls {
     const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
     const lane::vec4 shift{glue(0), glue(1), 0.0f, 0.0f};
     const lane::vec4 to_line{glue(6), glue(7), glue(8), 0.0f};
+    Tint(r, m, params_, lane::vec4{glue(11), glue(12), glue(13), glue(14)},
+         lane::dot(lane::vec2(r.dx, r.dy), lane::vec2(glue(9), glue(10))));
     const lane::vec2 p =
         lane::place(lane::glue_point(linear, shift, lane::vec2(r.ox, r.oy)), to_line, push);
     const lane::vec2 dh = lane::glue_direction(linear, lane::vec2(r.dx, r.dy));
@@ -278,8 +316,8 @@ class Walls {
   size_t vectors_ = 1;
   std::array<Table<float>, kFields> lookup_;  // [field][edge]
   // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
-  // (3); and the destination polygon.
-  static constexpr size_t kGlueFields = 9;
+  // (3), its own line's normal (2) and its tint (4); and the destination polygon.
+  static constexpr size_t kGlueFields = 15;
   std::array<Table<float>, kGlueFields> glue_;
   Table<int32_t> to_polygon_, first_edge_;
   KernelParams params_;
