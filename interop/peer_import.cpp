@@ -624,7 +624,12 @@ class Importer {
       strength = node.number();
       if (strength < 0.0 || strength > 1.0) node.fail("fog_effect_strength lies in [0, 1]");
     }
-    look_ = {{"wall_tint", strength}, {"fog", {0.0, 0.0, 0.0}}};
+    // The app's look: a white background, every crossing darker, no colours on walls.
+    look_ = {{"wall_tint", strength},
+             {"fog", {0.0, 0.0, 0.0}},
+             {"sky", {1.0, 1.0, 1.0}},
+             {"ground", {1.0, 1.0, 1.0}},
+             {"mirror", {0.0, 0.0, 0.0}}};
     add("/fog_effect_strength", Severity::converted,
         std::string(root_.has("fog_effect_strength")
                         ? ""
@@ -632,7 +637,10 @@ class Importer {
                               "; ") +
             "the app subtracts n * " + format_number(strength) +
             " from the colour after n wall crossings, the scene multiplies it by (1 - " +
-            format_number(strength) + ")^n (wall_tint, towards a black fog): equal to first order");
+            format_number(strength) +
+            ")^n (wall_tint, with black walls and mirrors: equal to first order at normal "
+            "incidence; here the walls are up to four times as dark at grazing incidence), on a "
+            "white sky and ground that darken into a black fog at the horizon");
   }
 
   void report_unknown_keys() {
@@ -655,6 +663,9 @@ class Importer {
     if (markers_) doc[markers_->first] = {{"radius", markers_->second}};
     doc["camera"] = camera_;
     doc["look"] = look_;
+    // Glued walls black like the app's: each crossing only darkens.
+    doc["look"]["gluings"] = nlohmann::ordered_json::array();
+    for (size_t k = 0; k < gluings_.size(); ++k) doc["look"]["gluings"].push_back({0.0, 0.0, 0.0});
     return doc;
   }
 

@@ -65,13 +65,14 @@ Vec3 linear_from_hex(const char* hex) {
   return c;
 }
 
+double encode_srgb(double linear) {
+  const double v = std::clamp(linear, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
 std::string hex_from_linear(Vec3 c) {
   int byte[3];
-  for (int i = 0; i < 3; ++i) {
-    const double v = std::clamp(c[i], 0.0, 1.0);
-    const double e = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-    byte[i] = static_cast<int>(std::lround(255.0 * e));
-  }
+  for (int i = 0; i < 3; ++i) byte[i] = static_cast<int>(std::lround(255.0 * encode_srgb(c[i])));
   char buf[8];
   std::snprintf(buf, sizeof buf, "#%02x%02x%02x", byte[0], byte[1], byte[2]);
   return buf;

@@ -161,7 +161,9 @@ struct Look {
 // The palette glued pairs take by default, in sRGB as the floor plan writes it (Tableau 10
 // without its pink, which the floor plan's light ray uses).
 const std::vector<const char*>& gluing_palette();
-// An sRGB "#rrggbb" colour as linear RGB, and back (IEC 61966-2-1, rounded to 8 bits).
+// A linear value in [0, 1] encoded to sRGB (IEC 61966-2-1; clamped).
+double encode_srgb(double linear);
+// An sRGB "#rrggbb" colour as linear RGB, and back (rounded to 8 bits).
 Vec3 linear_from_hex(const char* hex);
 std::string hex_from_linear(Vec3 c);
 

@@ -177,6 +177,14 @@ std::vector<Case> cases() {
       // The look.
       {"wall_tint", with_square(R"("look": {"wall_tint": 1.5})"), "/look/wall_tint", "[0, 1]"},
       {"fog_colour", with_square(R"("look": {"fog": [0.5, 2, 0.5]})"), "/look/fog/1", "[0, 1]"},
+      {"background", with_square(R"("look": {"background": [1, 1, 1]})"), "/look/background",
+       "give \"sky\""},
+      {"fog_distance", with_square(R"("look": {"fog_distance": 0})"), "/look/fog_distance",
+       "positive"},
+      // The square has no gluings: no colour for one.
+      {"gluing_colours", with_square(R"("look": {"gluings": [[1, 0, 0]]})"), "/look/gluings",
+       "at most 0"},
+      {"sky_colour", with_square(R"("look": {"sky": [0.5, 0.5]})"), "/look/sky", "3"},
   };
 }
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/backend.hpp"
+#include "output/image_io.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
@@ -59,6 +60,40 @@ TEST(CliScalar, WarnsThatOffsetNotAboveEpsPingPongs) {
   const nlohmann::json trace = nlohmann::json::parse(r.out);
   EXPECT_EQ(trace["events"].back()["kind"], "max_steps");
   EXPECT_EQ(trace["steps"], 50);
+}
+
+// Sphere tracing with 3 steps leaves most rays of the torus undecided (max_steps): by default
+// they are shaded as fog (no black), with --show-failures magenta; the hit AOV says max_steps
+// either way.
+TEST(CliScalar, ShowFailuresPaintsTheFailedRaysMagenta) {
+  const std::string torus = FLATMARCH_SOURCE_DIR "/scenes/torus.json";
+  const fs::path dir = test::make_temp_dir();
+  const std::vector<std::string> args{"render", torus,      "--size", "8x6",         "--backend",
+                                      "scalar", "--method", "sphere", "--max-steps", "3"};
+  for (const bool show : {false, true}) {
+    const std::string png = (dir / (show ? "shown.png" : "fog.png")).string();
+    std::vector<std::string> a = args;
+    a.insert(a.end(), {"-o", png});
+    if (show) a.push_back("--show-failures");
+    const auto r = test::run_flatmarch(a);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err.find("pixels failed") != std::string::npos, show) << r.err;
+    const Png image = read_png(png);
+    const Frame aovs = read_aov_exr(aov_path(png));
+    int failed = 0;
+    for (size_t px = 0; px < aovs.hit.size(); ++px) {
+      const uint8_t* p = &image.rgb[3 * px];
+      const bool magenta = p[0] == 255 && p[1] == 0 && p[2] == 255;
+      EXPECT_GT(std::max({p[0], p[1], p[2]}), 8) << "a black pixel";
+      if (aovs.hit[px] != kHitMaxSteps) {
+        EXPECT_FALSE(magenta);
+        continue;
+      }
+      ++failed;
+      EXPECT_EQ(magenta, show);
+    }
+    EXPECT_GE(failed, 24);  // most of the 48
+  }
 }
 
 }  // namespace

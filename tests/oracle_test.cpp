@@ -8,6 +8,7 @@
 #include "backends/oracle/intersect.hpp"
 #include "backends/oracle/oracle.hpp"
 #include "kernels/camera.hpp"
+#include "kernels/compile.hpp"
 #include "output/image_io.hpp"
 #include "scene/load.hpp"
 #include "tests/process.hpp"
@@ -416,6 +417,67 @@ TEST(OracleRender, LookingStraightUpEverythingEscapes) {
       const Vec3 sky = sky_seen(s.look, d.z);
       for (int k = 0; k < 3; ++k) EXPECT_NEAR(f.rgb[3 * px + static_cast<size_t>(k)], sky[k], 1e-6);
     }
+}
+
+// DESIGN.md section 1 (Appearance), by hand: a torus whose gluing 0 (bottom to top) is red and
+// gluing 1 (right to left) green, walls of opacity 0.2 at normal incidence, a black fog far
+// away. A ray from the centre crosses one wall (max_distance ends it before the next): the
+// light it gathers is the wall's opacity times its colour, and the share that passes 1 - a.
+TEST(OracleRender, AGluedWallTintsInItsColourMoreAtGrazingIncidence) {
+  const Scene s = load(test::torus_json(
+      R"("look": {"wall_tint": 0.2, "fog": [0, 0, 0], "fog_distance": 1e9,
+                  "gluings": [[1, 0, 0], [0, 1, 0]]})"));
+  struct Case {
+    Vec3 from, dir;
+    double max_distance;
+    Vec3 colour;
+    double cosine;  // of the direction with the crossed wall's normal
+  };
+  const double c60 = std::cos(kPi / 3.0), s60 = std::sin(kPi / 3.0);
+  const Case cases[] = {
+      {{2, 2, 1}, {1, 0, 0}, 3.0, {0, 1, 0}, 1.0},      // the right wall (gluing 1) head-on
+      {{2, 2, 1}, {c60, s60, 0}, 2.5, {1, 0, 0}, s60},  // the top (gluing 0) at 30 degrees
+      {{2, 2, 1}, {s60, c60, 0}, 2.5, {0, 1, 0}, s60},  // the right at 30 degrees
+      // The right wall at grazing incidence: about 3.4 times the opacity.
+      {{3.99, 2, 1}, {0.1, 1, 0}, 1.5, {0, 1, 0}, 0.1 / std::hypot(0.1, 1.0)}};
+  for (const Case& c : cases) {
+    const double grazing = 1.0 - c.cosine;
+    const double a = 0.2 * (1.0 + 3.0 * grazing * grazing);
+    MarchParams params;
+    params.max_distance = c.max_distance;
+    const RayEnd end = trace(s, c.from, c.dir, 0, params).end;
+    ASSERT_EQ(end.crossings, 1);
+    ASSERT_EQ(end.hit, kHitMaxDistance);
+    expect_near(end.light, a * c.colour, 1e-8);  // the fog 1e9 away: (1 - 2e-9) of the colour
+    EXPECT_NEAR(end.clear, 1.0 - a, 1e-12);
+    // The kernel (here in float64) gathers the same.
+    params.method = Method::analytic;
+    const auto tables = kernel::compile_scene<double>(s, params);
+    kernel::with_kernel<double>(tables, [&](auto& k) {
+      const auto r = k.march(0, c.from, glm::normalize(c.dir));
+      EXPECT_EQ(r.crossings, 1);
+      expect_near(Vec3(r.light), a * c.colour, 1e-8);
+      EXPECT_NEAR(r.clear, 1.0 - a, 1e-12);
+    });
+  }
+}
+
+// A ray that fails is shaded as the fog, not black (issue 20); --show-failures paints it.
+TEST(OracleRender, AFailedRayIsFogAndShowFailuresPaintsIt) {
+  const Scene s = load(test::torus_json(R"("look": {"fog": [0.2, 0.3, 0.4]})"));
+  MarchParams params;
+  params.max_distance = 1.0;  // every ray from the centre ends inside the room
+  Camera cam{0, {2, 2, 1}, 0.0, 0.0, 60.0};
+  Frame f = OracleBackend().render(s, cam, 4, 2, params, {});
+  for (size_t px = 0; px < f.hit.size(); ++px) {
+    ASSERT_EQ(f.hit[px], kHitMaxDistance);
+    EXPECT_NEAR(f.rgb[3 * px], display(0.2), 1e-6);
+    EXPECT_NEAR(f.rgb[3 * px + 1], display(0.3), 1e-6);
+    EXPECT_NEAR(f.rgb[3 * px + 2], display(0.4), 1e-6);
+  }
+  EXPECT_EQ(f.paint_failures({1, 0, 1}), 8);
+  EXPECT_EQ(f.rgb[0], 1.0f);
+  EXPECT_EQ(f.rgb[1], 0.0f);
 }
 
 TEST(OracleRender, AovExrRoundTrip) {

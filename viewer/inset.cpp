@@ -16,7 +16,6 @@ struct Colour {
   float r, g, b;
 };
 constexpr Colour kBackdrop{0.1f, 0.1f, 0.12f};
-constexpr Colour kGlued{0.95f, 0.6f, 0.2f};
 constexpr Colour kMirror{0.55f, 0.75f, 0.95f};
 constexpr Colour kWall{0.75f, 0.75f, 0.75f};
 constexpr Colour kCurrent{1.0f, 1.0f, 0.55f};  // the camera's polygon, under its edges
@@ -57,6 +56,15 @@ InsetBox inset_box(const Scene& scene, int window_width, int window_height) {
   return {window_width - kMargin - width, kMargin, width, height};
 }
 
+// A glued edge in its gluing's colour (the one it tints the rooms with and the floor plan draws
+// it in), brightened to show on the dark backdrop: the same hue, its brightest channel 0.95.
+Colour gluing_colour(const Look& look, int gluing) {
+  const Vec3 c = look.gluing_colour(gluing);
+  const double top = std::max({c.x, c.y, c.z, 1e-6});
+  const auto encode = [&](double v) { return static_cast<float>(0.95 * encode_srgb(v / top)); };
+  return {encode(c.x), encode(c.y), encode(c.z)};
+}
+
 std::vector<InsetVertex> inset_triangles(const Scene& scene, const Camera& camera,
                                          const InsetBox& box) {
   const PlanLayout layout(scene, box.width);
@@ -71,11 +79,11 @@ std::vector<InsetVertex> inset_triangles(const Scene& scene, const Camera& camer
     t.line(at(current.vertex(i)), at(current.vertex(i + 1)), 5.0, kCurrent);
   for (const Polygon& polygon : scene.polygons)
     for (int i = 0; i < polygon.size(); ++i) {
-      const EdgeKind kind = polygon.edges[static_cast<size_t>(i)].kind;
+      const Edge& edge = polygon.edges[static_cast<size_t>(i)];
       t.line(at(polygon.vertex(i)), at(polygon.vertex(i + 1)), 2.0,
-             kind == EdgeKind::glued    ? kGlued
-             : kind == EdgeKind::mirror ? kMirror
-                                        : kWall);
+             edge.kind == EdgeKind::glued    ? gluing_colour(scene.look, edge.gluing)
+             : edge.kind == EdgeKind::mirror ? kMirror
+                                             : kWall);
     }
   const Vec2 c = at(Vec2(camera.position));
   const double yaw = camera.yaw_deg * kPi / 180.0;
