@@ -355,7 +355,8 @@ void read_look(const JsonNode& root, Scene& scene) {
     if (node.has(key)) *colour = node[key].color();
   if (node.has("gluings")) {
     const JsonNode list = node["gluings"];
-    const size_t n = list.array_size(0, scene.gluings.size());
+    // A translation prism's glued floor and ceiling take the colour after the gluings'.
+    const size_t n = list.array_size(0, scene.gluings.size() + (scene.period ? 1 : 0));
     for (size_t k = 0; k < n; ++k) look.gluings.push_back(list[k].color());
   }
 }

@@ -148,7 +148,8 @@ struct Look {
   Vec3 wall{0.55, 0.55, 0.55};     // opaque walls, lit
   Vec3 floor{0.55, 0.55, 0.55};    // the floor's light checks, lit (the dark ones are darker)
   Vec3 mirror{0.3, 0.35, 0.45};    // a mirror's tint: a dark, bluish silver
-  // A colour per gluing, in the scene's gluing order; gluings beyond these take the palette's
+  // A colour per gluing, in the scene's gluing order, and in a translation prism one more for its
+  // glued floor and ceiling; gluings beyond these take the palette's
   // at kPaletteShade of its light (the colours mix into what rays see, and far enough away
   // into the horizon: full-strength colours would wash it out).
   std::vector<Vec3> gluings;

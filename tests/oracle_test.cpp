@@ -462,6 +462,20 @@ TEST(OracleRender, AGluedWallTintsInItsColourMoreAtGrazingIncidence) {
   }
 }
 
+// A translation prism's glued floor and ceiling tint too, in the colour one past the gluings'.
+TEST(OracleRender, APrismsGluedCeilingTintsInTheColourAfterTheGluings) {
+  const Scene s = load(test::torus_json(
+      R"("period": 2, "look": {"wall_tint": 0.2, "fog": [0, 0, 0], "fog_distance": 1e9,
+                               "gluings": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]})"));
+  MarchParams params;
+  params.max_distance = 1.5;  // from z = 1 straight up: through the ceiling at t = 1, once
+  const RayEnd end = trace(s, {2, 2, 1}, {0, 0, 1}, 0, params).end;
+  expect_near(end.light, 0.2 * Vec3(0, 0, 1), 1e-8);
+  EXPECT_NEAR(end.clear, 0.8, 1e-12);
+  EXPECT_THROW(load(test::torus_json(R"("look": {"gluings": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]})")),
+               SceneError);
+}
+
 // A ray that fails is shaded as the fog, not black (issue 20); --show-failures paints it.
 TEST(OracleRender, AFailedRayIsFogAndShowFailuresPaintsIt) {
   const Scene s = load(test::torus_json(R"("look": {"fog": [0.2, 0.3, 0.4]})"));
