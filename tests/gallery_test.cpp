@@ -42,6 +42,9 @@ const std::map<std::string, Surface>& expected() {
   static const std::map<std::string, Surface> table = {
       {"torus", kTorus},
       {"torus_prism", kTorus},
+      // Affine tori: corner angles still sum to 2 pi at the one vertex class.
+      {"affine_torus", kTorus},
+      {"affine_two_rooms", kTorus},
       {"l_shape", kGenus2},
       {"l_shape_prism", kGenus2},
       {"l_shape_singularities", kGenus2},
@@ -70,6 +73,36 @@ TEST(Gallery, HasEverySurfaceOfThePaperAndTheApp) {
   for (const fs::path& f : test::gallery_files()) stems.insert(f.stem().string());
   for (const auto& [name, surface] : expected())
     EXPECT_TRUE(stems.count(name)) << name << " is missing";
+}
+
+// The affine scenes' side gluings, worked out by hand from DESIGN.md section 1 (g(A) = D,
+// g(B) = C for edge a from A to B and edge b from C to D): the matrix as the file gives it (rows)
+// and the translation that then takes A to D.
+TEST(Gallery, AffineMapsAreTheMatricesGiven) {
+  struct Want {
+    const char* scene;
+    int gluing;
+    Mat2 linear;  // glm: columns
+    Vec2 translation;
+    GluingType type;
+  };
+  const Want wants[] = {
+      // Right (3,0)-(3,3) to left (0,3)-(0,0): (x, y) -> (x, x/2 + y) + t, t = (0,0) - (3, 1.5).
+      {"affine_torus", 1, Mat2(Vec2(1, 0.5), Vec2(0, 1)), {-3, -1.5}, GluingType::affine},
+      // The square's right (1,0)-(1,1) to the long room's left (2,1)-(2,0): x2 in x, no shift.
+      {"affine_two_rooms", 0, Mat2(Vec2(2, 0), Vec2(0, 1)), {0, 0}, GluingType::affine},
+      // The long room's right (4,0)-(4,1) to the square's left (0,1)-(0,0): (2, 0) + t = (0, 0).
+      {"affine_two_rooms", 1, Mat2(Vec2(0.5, 0), Vec2(0, 1)), {-2, 0}, GluingType::affine},
+  };
+  for (const Want& w : wants) {
+    const Scene& s = test::gallery_scene(w.scene);
+    const Gluing& g = s.gluings[static_cast<size_t>(w.gluing)];
+    EXPECT_EQ(g.type, w.type) << w.scene;
+    for (int c = 0; c < 2; ++c)
+      for (int r = 0; r < 2; ++r) EXPECT_NEAR(g.g.linear[c][r], w.linear[c][r], 1e-12) << w.scene;
+    EXPECT_NEAR(g.g.translation.x, w.translation.x, 1e-12) << w.scene;
+    EXPECT_NEAR(g.g.translation.y, w.translation.y, 1e-12) << w.scene;
+  }
 }
 
 class GalleryScene : public testing::TestWithParam<fs::path> {};
