@@ -164,10 +164,6 @@ Exit exit_edge(int polygon, vec2 o, vec2 dh) {
   return x;
 }
 
-// A ray at edge k of its polygon goes through it into the glued room, or is reflected by a
-// mirror. Either way its point is then placed `push` inside the edge it is now behind (the
-// paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
-// one it was.
 // A glued wall or mirror of tint `tint` (the edge table's), crossed with the component
 // `cosine` of the ray's direction along its normal, tints what lies beyond it (DESIGN.md
 // section 1, Appearance), seen through the fog as far away as it is.
@@ -178,6 +174,10 @@ void tint_ray(INOUT(Ray) r, vec4 tint, real cosine) {
   r.clear = r.clear * (real(1) - a);
 }
 
+// A ray at edge k of its polygon goes through it into the glued room, or is reflected by a
+// mirror. Either way its point is then placed `push` inside the edge it is now behind (the
+// paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
+// one it was.
 void cross_edge(INOUT(Ray) r, int k, real push) {
   EdgeRecord edge = edge_at(r.polygon, k);
   vec4 line = edge.line;
