@@ -107,15 +107,17 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
   uint8_t bits = 0;
   bool ends_on_edge = false;
   for (int v = 0; v < polygon.size(); ++v) {
-    const Vec2 a = polygon.vertex(v), b = polygon.vertex(v + 1);
-    if (distance_to_segment(a, from, to) < delta) bits |= kNearVertex;
-    // Two segments that do not cross come closest at an end of one of them: the edge's ends are
-    // the vertices; the path's ends count unless they lie on this edge.
+    const Edge& edge = polygon.edges[static_cast<size_t>(v)];
+    if (!polygon.is_ideal(v) && distance_to_segment(polygon.vertex(v), from, to) < delta)
+      bits |= kNearVertex;
+    // Two segments (or a segment and a ray) that do not cross come closest at an end of one of
+    // them: the edge's ends are the vertices; the path's ends count unless they lie on this
+    // edge. Nothing comes near an edge at infinity.
     for (const Vec2 q : {from, to}) {
-      const double d = distance_to_segment(q, a, b);
+      const double d = edge.distance(q);
       if (d >= on && d < delta) bits |= kNearEdge;
     }
-    ends_on_edge |= distance_to_segment(to, a, b) < on;
+    ends_on_edge |= edge.distance(to) < on;
   }
   if (!scene.period) {
     const bool at_band = std::abs(seg.to.z) < on || std::abs(seg.to.z - scene.height) < on;
@@ -218,7 +220,7 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
     if (last || !scene.in_band(seg.from.z)) continue;
     const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
     for (int e = 0; e < polygon.size(); ++e)
-      if (distance_to_segment(Vec2(seg.to), polygon.vertex(e), polygon.vertex(e + 1)) < on) {
+      if (polygon.edges[static_cast<size_t>(e)].distance(Vec2(seg.to)) < on) {
         const Vec3 step = seg.to - seg.from;
         const double length = glm::length(step);
         const Vec3 n(polygon.edges[static_cast<size_t>(e)].normal, 0.0);

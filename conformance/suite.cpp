@@ -24,11 +24,11 @@ bool generic(const Scene& scene, const OracleResult& r, double margin, double mi
     t += glm::length(step);
     const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
     for (int v = 0; v < polygon.size(); ++v) {
-      if (distance_to_segment(polygon.vertex(v), Vec2(seg.from), Vec2(seg.to)) < margin)
+      if (!polygon.is_ideal(v) &&
+          distance_to_segment(polygon.vertex(v), Vec2(seg.from), Vec2(seg.to)) < margin)
         return false;
       const Edge& edge = polygon.edges[static_cast<size_t>(v)];
-      const bool ends_on_edge =
-          distance_to_segment(Vec2(seg.to), polygon.vertex(v), polygon.vertex(v + 1)) < 1e-9;
+      const bool ends_on_edge = edge.distance(Vec2(seg.to)) < 1e-9;
       if (ends_on_edge && glm::length(step) > 0.0 &&
           std::abs(glm::dot(Vec2(step), edge.normal)) < min_sine * glm::length(step))
         return false;
@@ -73,8 +73,10 @@ std::vector<Ray> probe_rays(const Scene& scene, int count, int events) {
   for (int attempt = 0; attempt < 100 * count && static_cast<int>(rays.size()) < count; ++attempt) {
     const int p = static_cast<int>(unit(rng) * static_cast<double>(scene.polygons.size()));
     const Polygon& polygon = scene.polygons[static_cast<size_t>(p)];
-    Vec2 lo = polygon.vertices[0], hi = lo;
-    for (const Vec2& v : polygon.vertices) lo = glm::min(lo, v), hi = glm::max(hi, v);
+    // Within the polygon's box; an unbounded one's cut off a few units of scale out.
+    const std::vector<Vec2> outline = polygon.outline(4.0 * scene.scale);
+    Vec2 lo = outline[0], hi = lo;
+    for (const Vec2& v : outline) lo = glm::min(lo, v), hi = glm::max(hi, v);
     const Vec2 xy = lo + Vec2(unit(rng), unit(rng)) * (hi - lo);
     if (!polygon.contains(xy, 0.05 * scene.scale)) continue;
     const double angle = 2.0 * kPi * unit(rng);

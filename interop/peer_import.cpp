@@ -233,6 +233,7 @@ class Importer {
     numbering_ = {n, clockwise};
     for (int j = 0; j < n; ++j)
       polygon_.vertices.push_back(vertices[static_cast<size_t>(numbering_.vertex(j))]);
+    init_edges(polygon_, EdgeKind::mirror);  // for distances to its edges
     if (clockwise)
       add(list.pointer(), Severity::converted,
           "the polygon is listed clockwise; the scene lists it counterclockwise from the same "

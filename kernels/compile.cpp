@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace flatmarch::kernel {
 
@@ -90,9 +92,35 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
     const Polygon& polygon = scene.polygons[p];
     const int first_edge = static_cast<int>(t.edges.size());
     const int first_object = static_cast<int>(t.objects.size());
+    // An unbounded polygon's room is its outline cut off kFarRadius out (Polygon::outline):
+    // a ray edge runs from its finite end to its far point, the edge at infinity is the first
+    // link of the chain of far points, and the chain's other links follow the polygon's edges.
+    // No ray gets near the far points (check_reach), so within its reach a ray edge is the
+    // half-line exactly and the edge at infinity nothing at all, and the kernel is the one
+    // finite scenes run.
+    const std::vector<Vec2> far = polygon.far_points(kFarRadius);
+    std::vector<std::pair<Vec2, Vec2>> chain;
+    for (size_t k = 0; k + 1 < far.size(); ++k) chain.push_back({far[k], far[k + 1]});
+    const auto far_link = [&](Vec2 a, Vec2 b, Vec2 inward) {
+      typename Tables<real>::EdgeRecord r{};
+      const Vec2 normal = -glm::normalize(inward);
+      r.segment = vec4(real(a.x), real(a.y), real(b.x), real(b.y));
+      r.line = vec4(real(normal.x), real(normal.y), real(glm::dot(normal, a)),
+                    real(1.0 / glm::dot(b - a, b - a)));
+      r.link.x = kEdgeWall;  // never reached: nothing to cross, no wall feature
+      return r;
+    };
+    size_t next_link = 0;
     for (int i = 0; i < polygon.size(); ++i) {
       const Edge& edge = polygon.edges[static_cast<size_t>(i)];
-      const Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1);
+      if (edge.shape == EdgeShape::at_infinity) {
+        const auto [a, b] = chain[next_link++];
+        t.edges.push_back(far_link(a, b, perp(b - a)));
+        continue;
+      }
+      Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1);
+      if (edge.shape == EdgeShape::ray_out) a = edge.start, b = far.front();
+      if (edge.shape == EdgeShape::ray_in) a = edge.start, b = far.back();
       typename Tables<real>::EdgeRecord r{};
       r.segment = vec4(real(a.x), real(a.y), real(b.x), real(b.y));
       r.line = vec4(real(edge.normal.x), real(edge.normal.y), real(glm::dot(edge.normal, a)),
@@ -110,6 +138,11 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
       r.tint = vec4(edge_tint(scene.look, edge));
       t.edges.push_back(r);
     }
+    for (; next_link < chain.size(); ++next_link) {
+      const auto [a, b] = chain[next_link];
+      t.edges.push_back(far_link(a, b, perp(b - a)));
+    }
+    const int edge_count = static_cast<int>(t.edges.size()) - first_edge;
     // The room's solids: its objects, then a cylinder at each corner that carries a marker.
     for (size_t k = 0; k < scene.objects.size(); ++k)
       if (scene.objects[k].polygon == static_cast<int>(p))
@@ -126,7 +159,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
       t.objects.push_back(
           object_record<real>(cylinder, static_cast<int>(scene.objects.size()) + m));
     }
-    t.polygons.push_back(ivec4(first_edge, polygon.size(), first_object,
+    t.polygons.push_back(ivec4(first_edge, edge_count, first_object,
                                static_cast<int>(t.objects.size()) - first_object));
   }
 
@@ -137,6 +170,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
   k.eps = real(march.eps);
   k.offset = real(march.offset);
   k.max_distance = real(march.max_distance);
+  check_reach(scene, march);
   k.omega = real(march.omega);
   k.height = real(scene.height);
   k.top = real(top);
@@ -157,6 +191,20 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
   return t;
 }
 
+void check_reach(const Scene& scene, const MarchParams& march) {
+  if (!scene.topology.infinite) return;
+  double camera = 0.0;
+  for (const Polygon& polygon : scene.polygons)
+    for (int v = 0; v < polygon.size(); ++v)
+      if (!polygon.is_ideal(v)) camera = std::max(camera, glm::length(polygon.vertex(v)));
+  camera = std::max(camera, glm::length(Vec2(scene.camera.position)));
+  if (camera + march.max_distance > kReach)
+    throw std::invalid_argument(
+        "an unbounded scene is modelled out to " + std::to_string(kReach) +
+        " from its origin; the camera's distance from it plus max_distance (" +
+        std::to_string(camera + march.max_distance) + ") must stay within that");
+}
+
 glm::dvec4 edge_tint(const Look& look, const Edge& edge) {
   switch (edge.kind) {
     case EdgeKind::glued:
@@ -164,6 +212,7 @@ glm::dvec4 edge_tint(const Look& look, const Edge& edge) {
     case EdgeKind::mirror:
       return {look.mirror, look.wall_tint};
     case EdgeKind::wall:
+    case EdgeKind::infinity:
       break;
   }
   return glm::dvec4(0.0);

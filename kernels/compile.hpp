@@ -22,7 +22,19 @@ struct SceneTables {
 // The feature set of a scene (kFeature*).
 uint scene_features(const Scene& scene);
 
-// `march.method` must be one the kernel runs (sphere, relaxed, analytic).
+// An unbounded polygon (DESIGN.md section 1, "Infinite surfaces") is compiled as its outline
+// cut off kFarRadius from its finite vertices (Polygon::outline), and rays must stay within
+// kReach of the origin, a thousandth of that: there the outline's ray edges are the half-lines
+// and its far links out of reach. In float the far points are rounded by ulp(2^40) = 2^17,
+// which turns a ray edge by at most 2^-23 radians: what any float direction is rounded by.
+inline constexpr double kFarRadius = 0x1p40;
+inline constexpr double kReach = 0x1p30;
+
+// Throws std::invalid_argument if an unbounded scene's camera or max_distance would take rays
+// beyond kReach.
+void check_reach(const Scene& scene, const MarchParams& march);
+
+// `march.method` must be one the kernel runs (sphere, relaxed, analytic); throws as check_reach.
 template <typename real>
 SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march);
 

@@ -57,8 +57,8 @@ class Svg {
 
 // Unit vector into the polygon that splits the corner at vertex v (pixel frame, y down).
 Vec2 inward_bisector(const Polygon& polygon, int v) {
-  const Vec2 in = glm::normalize(polygon.vertex(v) - polygon.vertex(v - 1));
-  const Vec2 out = glm::normalize(polygon.vertex(v + 1) - polygon.vertex(v));
+  const Vec2 in = glm::normalize(polygon.heading(v - 1));
+  const Vec2 out = glm::normalize(polygon.heading(v));
   Vec2 b = perp(in) + perp(out);  // the interior lies to the left of both edges
   b = glm::length(b) > 1e-9 ? glm::normalize(b) : perp(out);
   return {b.x, -b.y};
@@ -68,7 +68,7 @@ void draw_polygons(Svg& svg, const Scene& scene, const PlanLayout& layout) {
   svg << "<defs>";
   for (size_t p = 0; p < scene.polygons.size(); ++p) {
     svg << "<clipPath id=\"polygon-" << p << "\"><polygon points=\"";
-    for (const Vec2& v : scene.polygons[p].vertices) svg.point(layout.to_pixels(v)) << " ";
+    for (const Vec2& v : layout.outline(scene.polygons[p])) svg.point(layout.to_pixels(v)) << " ";
     svg << "\"/></clipPath>";
   }
   svg << "</defs>\n";
@@ -76,7 +76,7 @@ void draw_polygons(Svg& svg, const Scene& scene, const PlanLayout& layout) {
     const Polygon& polygon = scene.polygons[p];
     svg << "<polygon class=\"polygon\" data-polygon=\"" << p
         << "\" fill=\"#f4f1e8\" stroke=\"#d8d2c2\" points=\"";
-    for (const Vec2& v : polygon.vertices) svg.point(layout.to_pixels(v)) << " ";
+    for (const Vec2& v : layout.outline(polygon)) svg.point(layout.to_pixels(v)) << " ";
     svg << "\"/>\n";
     if (scene.polygons.size() > 1) {
       const Vec2 c = layout.to_pixels(polygon.centroid());
@@ -101,8 +101,9 @@ void draw_edges(Svg& svg, const Scene& scene, const PlanLayout& layout) {
     const Polygon& polygon = scene.polygons[p];
     for (int i = 0; i < polygon.size(); ++i) {
       const Edge& e = polygon.edges[static_cast<size_t>(i)];
-      const Vec2 a = layout.to_pixels(polygon.vertex(i)),
-                 b = layout.to_pixels(polygon.vertex(i + 1));
+      const PlanEdge drawn = plan_edge(polygon, i, layout.radius());
+      if (!drawn.drawn) continue;  // at infinity: the outline's cut-off arc shows where it lies
+      const Vec2 a = layout.to_pixels(drawn.a), b = layout.to_pixels(drawn.b);
       const auto line = [&](const char* cls, const std::string& colour, double width,
                             const char* dash) {
         svg << "<line class=\"" << cls << "\" data-polygon=\"" << p << "\" data-edge=\"" << i
@@ -297,10 +298,41 @@ std::string xml_escape(const std::string& s) {
   return out;
 }
 
-PlanLayout::PlanLayout(const Scene& scene, double width) : width_(width) {
+double plan_radius(const Scene& scene) {
+  double r = scene.scale;
+  for (const Polygon& p : scene.polygons)
+    for (int v = 0; v < p.size(); ++v)
+      if (!p.is_ideal(v)) r = std::max(r, glm::length(p.vertex(v)));
+  for (const Object& o : scene.objects)
+    r = std::max(r, glm::length(Vec2(o.center)) + o.footprint_radius());
+  r = std::max(r, glm::length(Vec2(scene.camera.position)));
+  return 1.25 * r;
+}
+
+PlanEdge plan_edge(const Polygon& polygon, int i, double radius) {
+  const Edge& e = polygon.edges[static_cast<size_t>(i)];
+  switch (e.shape) {
+    case EdgeShape::segment:
+      return {polygon.vertex(i), polygon.vertex(i + 1)};
+    case EdgeShape::ray_out:
+      return {e.start, e.start + radius * e.along};
+    case EdgeShape::ray_in:
+      return {e.start + radius * e.along, e.start};
+    case EdgeShape::at_infinity:
+      break;
+  }
+  return {Vec2(0.0), Vec2(0.0), false};
+}
+
+std::vector<Vec2> PlanLayout::outline(const Polygon& polygon) const {
+  return polygon.outline(radius_, 96);
+}
+
+PlanLayout::PlanLayout(const Scene& scene, double width)
+    : radius_(plan_radius(scene)), width_(width) {
   Vec2 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
   for (const Polygon& p : scene.polygons)
-    for (const Vec2& v : p.vertices) lo = glm::min(lo, v), hi = glm::max(hi, v);
+    for (const Vec2& v : outline(p)) lo = glm::min(lo, v), hi = glm::max(hi, v);
   const double margin = kMarginFraction * std::max(hi.x - lo.x, hi.y - lo.y);
   min_ = lo - Vec2(margin);
   max_ = hi + Vec2(margin);

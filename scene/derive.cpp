@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -15,19 +16,6 @@ std::string format_point(Vec2 p) {
   s.precision(12);
   s << "(" << p.x << ", " << p.y << ")";
   return s.str();
-}
-
-// Signed distance of c from the line through a and b (positive on the left).
-double side(Vec2 a, Vec2 b, Vec2 c) {
-  return cross(b - a, c - a) / glm::length(b - a);
-}
-
-bool segments_touch(Vec2 a, Vec2 b, Vec2 c, Vec2 d, double tol) {
-  const double o1 = side(a, b, c), o2 = side(a, b, d), o3 = side(c, d, a), o4 = side(c, d, b);
-  const bool proper = ((o1 > tol && o2 < -tol) || (o1 < -tol && o2 > tol)) &&
-                      ((o3 > tol && o4 < -tol) || (o3 < -tol && o4 > tol));
-  return proper || distance_to_segment(c, a, b) <= tol || distance_to_segment(d, a, b) <= tol ||
-         distance_to_segment(a, c, d) <= tol || distance_to_segment(b, c, d) <= tol;
 }
 
 bool near(const Mat2& m, const Mat2& n, double tol) {
@@ -60,36 +48,89 @@ class UnionFind {
 
 }  // namespace
 
-std::optional<PolygonProblem> check_polygon(const Polygon& polygon, double scale) {
+namespace {
+
+// Whether edges i and j (neither at infinity) of a polygon whose edge table is filled share a
+// point, to within tol: rays are half-lines, exactly.
+bool edges_touch(const Polygon& polygon, int i, int j, double tol) {
+  const Edge& e = polygon.edges[static_cast<size_t>(i)];
+  const Edge& f = polygon.edges[static_cast<size_t>(j)];
+  const auto ends = [](const Edge& g) {
+    std::vector<Vec2> points{g.start};
+    if (!g.ray()) points.push_back(g.start + g.length * g.along);
+    return points;
+  };
+  for (Vec2 p : ends(e))
+    if (f.distance(p) <= tol) return true;
+  for (Vec2 p : ends(f))
+    if (e.distance(p) <= tol) return true;
+  const double denom = cross(e.along, f.along);
+  if (std::abs(denom) <= 1e-15) return false;  // parallel, and no end on the other
+  const Vec2 w = f.start - e.start;
+  const double s = cross(w, f.along) / denom, t = cross(w, e.along) / denom;
+  return s > 0.0 && s < e.length && t > 0.0 && t < f.length;
+}
+
+}  // namespace
+
+std::optional<PolygonProblem> check_polygon(Polygon& polygon, double scale) {
   const int n = polygon.size();
   const double tol = 1e-12 * scale;
+  // Ideal vertices (DESIGN.md section 1, "Infinite surfaces"): at most two, next to each other.
+  int ideal = 0, first_ideal = -1;
+  for (int i = 0; i < n; ++i)
+    if (polygon.is_ideal(i)) {
+      if (++ideal > 2)
+        return PolygonProblem{i, "a polygon has at most two ideal vertices (this is the third)"};
+      if (first_ideal < 0) first_ideal = i;
+    }
+  if (ideal == 2 && !polygon.is_ideal(first_ideal + 1) && !polygon.is_ideal(first_ideal - 1))
+    return PolygonProblem{first_ideal,
+                          "the two ideal vertices of a polygon must be next to each other "
+                          "(the edge between them lies at infinity)"};
   for (int i = 0; i < n; ++i) {
+    if (polygon.is_ideal(i) || polygon.is_ideal(i + 1)) continue;
     if (glm::length(polygon.vertex(i + 1) - polygon.vertex(i)) <= tol)
       return PolygonProblem{(i + 1) % n, "repeats the previous vertex (edge " + std::to_string(i) +
                                              " has zero length)"};
   }
   for (int i = 0; i < n; ++i)
     for (int j = i + 2; j < n; ++j)
-      if (glm::length(polygon.vertex(j) - polygon.vertex(i)) <= tol)
+      if (!polygon.is_ideal(i) && !polygon.is_ideal(j) &&
+          glm::length(polygon.vertex(j) - polygon.vertex(i)) <= tol)
         return PolygonProblem{
             j, "repeats vertex " + std::to_string(i) + " " + format_point(polygon.vertex(i))};
   for (int i = 0; i < n; ++i) {
-    const Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1), c = polygon.vertex(i + 2);
-    if (std::abs(side(a, b, c)) <= tol && glm::dot(a - b, c - b) > 0.0)
+    if (polygon.is_ideal(i + 1)) continue;  // no corner at an ideal vertex
+    const Vec2 in = polygon.heading(i), out = polygon.heading(i + 1);
+    if (glm::length(in) == 0.0 || glm::length(out) == 0.0) continue;
+    if (std::abs(cross(in, out)) <= tol * glm::length(in) * glm::length(out) &&
+        glm::dot(in, out) < 0.0)
       return PolygonProblem{(i + 1) % n,
                             "edges " + std::to_string(i) + " and " + std::to_string((i + 1) % n) +
                                 " fold back onto each other: the polygon is not simple"};
   }
+  init_edges(polygon, EdgeKind::mirror);
   for (int i = 0; i < n; ++i)
     for (int j = i + 2; j < n; ++j) {
       if (i == 0 && j == n - 1) continue;  // adjacent through vertex 0
-      if (segments_touch(polygon.vertex(i), polygon.vertex(i + 1), polygon.vertex(j),
-                         polygon.vertex(j + 1), tol))
+      const auto at_infinity = [&](int k) {
+        return polygon.edges[static_cast<size_t>(k)].shape == EdgeShape::at_infinity;
+      };
+      if (at_infinity(i) || at_infinity(j)) continue;
+      if (edges_touch(polygon, i, j, tol))
         return PolygonProblem{-1, "edges " + std::to_string(i) + " and " + std::to_string(j) +
                                       " intersect: the polygon is not simple"};
     }
-  // Only a simple polygon's signed area says its orientation.
-  const double area = polygon.area();
+  // Only a simple polygon's signed area says its orientation; an unbounded one's is its
+  // outline's, cut off far out.
+  double area = polygon.area();
+  if (polygon.infinite()) {
+    const std::vector<Vec2> outline = polygon.outline(1e6 * scale);
+    area = 0.0;
+    for (size_t i = 0; i < outline.size(); ++i)
+      area += 0.5 * cross(outline[i], outline[(i + 1) % outline.size()]);
+  }
   if (std::abs(area) <= tol * scale) return PolygonProblem{-1, "the polygon has zero area"};
   if (area < 0.0)
     return PolygonProblem{-1, "the vertices are listed clockwise; list them counterclockwise"};
@@ -100,6 +141,61 @@ GluingMapResult derive_gluing_map(const Scene& scene, EdgeRef a, EdgeRef b, Glui
                                   const Mat2& matrix) {
   const Polygon& p = scene.polygons[static_cast<size_t>(a.polygon)];
   const Polygon& q = scene.polygons[static_cast<size_t>(b.polygon)];
+  const Edge& ea = scene.edge(a);
+  const Edge& eb = scene.edge(b);
+  const auto name = [](EdgeRef e) {
+    return "edge [" + std::to_string(e.polygon) + ", " + std::to_string(e.edge) + "]";
+  };
+  for (EdgeRef e : {a, b})
+    if (scene.edge(e).shape == EdgeShape::at_infinity)
+      return {{},
+              name(e) +
+                  " lies at infinity (between two ideal vertices): nothing reaches it, "
+                  "so it cannot be glued"};
+  if (ea.ray() != eb.ray()) {
+    const EdgeRef ray = ea.ray() ? a : b, segment = ea.ray() ? b : a;
+    return {{},
+            "a segment cannot be glued to a ray: " + name(ray) + " runs to infinity, " +
+                name(segment) + " is a segment"};
+  }
+  if (ea.ray()) {
+    // Rays (DESIGN.md section 1, "Infinite surfaces"): g takes the finite end of one to that
+    // of the other, and the direction of the one's ideal point to that of the other's.
+    const bool same_way = ea.shape == eb.shape;
+    GluingMapResult r;
+    switch (map) {
+      case GluingMap::similarity:
+      case GluingMap::matrix:
+        return {{},
+                std::string("rays are glued by an isometry (or \"map\": \"reflection\"); ") +
+                    (map == GluingMap::matrix ? "a \"matrix\"" : "\"similarity\"") +
+                    " would not keep their lengths, which are infinite"};
+      case GluingMap::isometry:
+        if (same_way)
+          return {{},
+                  name(a) + " and " + name(b) + " both run " +
+                      (ea.shape == EdgeShape::ray_out ? "out to" : "in from") +
+                      " infinity: an isometry glues a ray running out to one running in "
+                      "(\"map\": \"reflection\" glues two running the same way)"};
+        r.g.linear = rotation_between(ea.along, eb.along);
+        break;
+      case GluingMap::reflection: {
+        if (!same_way)
+          return {{},
+                  "a reflection glues two rays running the same way; " + name(a) + " runs " +
+                      (ea.shape == EdgeShape::ray_out ? "out to" : "in from") + " infinity and " +
+                      name(b) +
+                      " the other way (drop \"map\" for an "
+                      "isometry)"};
+        const Vec2 u = ea.along, v = eb.along;
+        const Vec2 w = glm::length(u + v) > 1e-6 ? glm::normalize(u + v) : perp(u);
+        r.g.linear = 2.0 * glm::outerProduct(w, w) - Mat2(1.0);
+        break;
+      }
+    }
+    r.g.translation = eb.start - r.g.linear * ea.start;
+    return r;
+  }
   const Vec2 A = p.vertex(a.edge), B = p.vertex(a.edge + 1);
   const Vec2 C = q.vertex(b.edge), D = q.vertex(b.edge + 1);
   const double la = glm::length(B - A), lb = glm::length(D - C);
@@ -173,10 +269,26 @@ void init_edges(Polygon& polygon, EdgeKind boundary) {
   polygon.edges.assign(polygon.vertices.size(), Edge{});
   for (int i = 0; i < polygon.size(); ++i) {
     Edge& e = polygon.edges[static_cast<size_t>(i)];
-    const Vec2 d = polygon.vertex(i + 1) - polygon.vertex(i);
+    const Vec2 d = polygon.heading(i);
     e.kind = boundary;
+    if (polygon.is_ideal(i) && polygon.is_ideal(i + 1)) {
+      e.kind = EdgeKind::infinity;
+      e.shape = EdgeShape::at_infinity;
+      e.length = std::numeric_limits<double>::infinity();
+      continue;  // no points, no normal
+    }
     e.length = glm::length(d);
     e.normal = -perp(d) / e.length;  // the interior of a counterclockwise polygon is on the left
+    e.start = polygon.vertex(i);
+    e.along = d / e.length;
+    if (polygon.is_ideal(i + 1)) {
+      e.shape = EdgeShape::ray_out;
+    } else if (polygon.is_ideal(i)) {
+      e.shape = EdgeShape::ray_in;
+      e.start = polygon.vertex(i + 1);
+      e.along = -e.along;
+    }
+    if (e.ray()) e.length = std::numeric_limits<double>::infinity();
   }
 }
 
@@ -220,6 +332,10 @@ void derive_vertex_classes(Scene& scene) {
     const Polygon& polygon = scene.polygons[p];
     scene.corner_class[p].resize(polygon.vertices.size());
     for (int v = 0; v < polygon.size(); ++v) {
+      if (polygon.is_ideal(v)) {  // a point at infinity is no vertex of the surface
+        scene.corner_class[p][static_cast<size_t>(v)] = -1;
+        continue;
+      }
       const size_t root = classes.find(corner(static_cast<int>(p), v));
       auto [it, added] =
           class_of_root.try_emplace(root, static_cast<int>(scene.vertex_classes.size()));
@@ -280,11 +396,13 @@ void derive_topology(Scene& scene) {
   for (size_t p = 0; p < np; ++p) {
     const Polygon& polygon = scene.polygons[p];
     for (int i = 0; i < polygon.size(); ++i) {
-      if (polygon.edges[static_cast<size_t>(i)].kind == EdgeKind::glued) continue;
+      const EdgeKind kind = polygon.edges[static_cast<size_t>(i)].kind;
+      if (kind == EdgeKind::glued || kind == EdgeKind::infinity) continue;
       ++boundary_edges;
-      boundary.unite(static_cast<size_t>(scene.corner_class[p][static_cast<size_t>(i)]),
-                     static_cast<size_t>(
-                         scene.corner_class[p][static_cast<size_t>((i + 1) % polygon.size())]));
+      const int from = scene.corner_class[p][static_cast<size_t>(i)];
+      const int to = scene.corner_class[p][static_cast<size_t>((i + 1) % polygon.size())];
+      if (from >= 0 && to >= 0)  // a boundary ray links its finite end to nothing
+        boundary.unite(static_cast<size_t>(from), static_cast<size_t>(to));
     }
   }
   t.boundary_components = 0;
@@ -293,10 +411,14 @@ void derive_topology(Scene& scene) {
 
   const int vertices = static_cast<int>(scene.vertex_classes.size());
   const int edges = static_cast<int>(scene.gluings.size()) + boundary_edges;
-  t.euler_characteristic = vertices - edges + static_cast<int>(np);
+  t.infinite = false;
+  for (const Polygon& polygon : scene.polygons) t.infinite = t.infinite || polygon.infinite();
+  t.euler_characteristic.reset();
   t.genus.reset();
+  if (t.infinite) return;  // no Euler characteristic, no genus
+  t.euler_characteristic = vertices - edges + static_cast<int>(np);
   if (t.components == 1) {
-    const int deficit = 2 - t.euler_characteristic - t.boundary_components;
+    const int deficit = 2 - *t.euler_characteristic - t.boundary_components;
     t.genus = t.orientable ? deficit / 2 : deficit;
   }
 }

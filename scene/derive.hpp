@@ -18,9 +18,11 @@ struct PolygonProblem {
   std::string message;
 };
 
-// Checks the rules for one polygon (finite, no repeated vertices or zero-length edges,
-// counterclockwise, simple); `scale` sets the tolerance of the geometric predicates.
-std::optional<PolygonProblem> check_polygon(const Polygon& polygon, double scale);
+// Checks the rules for one polygon (no repeated vertices or zero-length edges, counterclockwise,
+// simple; at most two ideal vertices, next to each other), filling its edge table (as
+// init_edges, every edge a mirror) on the way; `scale` sets the tolerance of the geometric
+// predicates.
+std::optional<PolygonProblem> check_polygon(Polygon& polygon, double scale);
 
 // Derives the map of a gluing from its edges (and `matrix` for GluingMap::matrix), or says why
 // it cannot be derived.

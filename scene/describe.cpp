@@ -22,7 +22,8 @@ std::string cone_angle_text(double radians) {
 
 std::string surface_summary(const Scene& scene) {
   const Topology& t = scene.topology;
-  std::string s = "χ = " + std::to_string(t.euler_characteristic) +
+  std::string s = (t.euler_characteristic ? "χ = " + std::to_string(*t.euler_characteristic)
+                                          : std::string("infinite")) +
                   (t.orientable ? ", orientable" : ", non-orientable");
   if (t.genus) s += (t.orientable ? ", genus " : ", cross-cap genus ") + std::to_string(*t.genus);
   if (t.boundary_components)

@@ -34,6 +34,11 @@ const char* map_name(GluingMap m) {
   return "?";
 }
 
+nlohmann::ordered_json vertex_json(const Polygon& polygon, int v) {
+  if (polygon.is_ideal(v)) return {{"to", point(polygon.vertex(v))}};
+  return point(polygon.vertex(v));
+}
+
 }  // namespace
 
 nlohmann::ordered_json inspect(const Scene& scene) {
@@ -46,19 +51,26 @@ nlohmann::ordered_json inspect(const Scene& scene) {
     const Polygon& polygon = scene.polygons[p];
     nlohmann::ordered_json vertices = nlohmann::ordered_json::array(),
                            angles = nlohmann::ordered_json::array();
+    // An ideal vertex is written as in the scene file, {"to": direction}; it has no corner.
     for (int v = 0; v < polygon.size(); ++v) {
-      vertices.push_back(point(polygon.vertex(v)));
-      angles.push_back(polygon.corner_angle(v));
+      vertices.push_back(vertex_json(polygon, v));
+      angles.push_back(polygon.is_ideal(v) ? nlohmann::ordered_json()
+                                           : nlohmann::ordered_json(polygon.corner_angle(v)));
     }
-    polygons.push_back(
-        {{"vertices", vertices}, {"corner_angles", angles}, {"area", polygon.area()}});
+    polygons.push_back({{"vertices", vertices},
+                        {"corner_angles", angles},
+                        {"area", polygon.infinite() ? nlohmann::ordered_json()
+                                                    : nlohmann::ordered_json(polygon.area())}});
     for (int i = 0; i < polygon.size(); ++i) {
       const Edge& e = polygon.edges[static_cast<size_t>(i)];
       nlohmann::ordered_json edge = {{"polygon", p},
                                      {"edge", i},
-                                     {"from", point(polygon.vertex(i))},
-                                     {"to", point(polygon.vertex(i + 1))},
-                                     {"length", e.length},
+                                     {"from", vertex_json(polygon, i)},
+                                     {"to", vertex_json(polygon, i + 1)},
+                                     {"shape", to_string(e.shape)},
+                                     {"length", e.ray() || e.shape == EdgeShape::at_infinity
+                                                    ? nlohmann::ordered_json()
+                                                    : nlohmann::ordered_json(e.length)},
                                      {"normal", point(e.normal)},
                                      {"kind", to_string(e.kind)}};
       if (e.kind == EdgeKind::glued) {
@@ -95,7 +107,10 @@ nlohmann::ordered_json inspect(const Scene& scene) {
   out["vertex_classes"] = std::move(classes);
 
   const Topology& t = scene.topology;
-  out["euler_characteristic"] = t.euler_characteristic;
+  out["infinite"] = t.infinite;
+  out["euler_characteristic"] = t.euler_characteristic
+                                    ? nlohmann::ordered_json(*t.euler_characteristic)
+                                    : nlohmann::ordered_json();
   out["orientable"] = t.orientable;
   out["genus"] = t.genus ? nlohmann::ordered_json(*t.genus) : nlohmann::ordered_json();
   out["components"] = t.components;

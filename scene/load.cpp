@@ -85,9 +85,24 @@ void read_polygons(const JsonNode& root, Scene& scene, EdgeKind boundary) {
     }
     const size_t nv = poly.array_size(3, SceneLimits::max_vertices_per_polygon);
     Polygon polygon;
-    for (size_t v = 0; v < nv; ++v) polygon.vertices.push_back(poly[v].vec2());
-    for (Vec2 v : polygon.vertices)
-      scene.scale = std::max({scene.scale, std::abs(v.x), std::abs(v.y)});
+    for (size_t v = 0; v < nv; ++v) {
+      const JsonNode vertex = poly[v];
+      if (vertex.json().is_object()) {  // an ideal vertex, {"to": [dx, dy]}
+        vertex.allow_keys({"to"});
+        Vec2 d = vertex["to"].vec2();
+        const double largest = std::max(std::abs(d.x), std::abs(d.y));
+        if (!(largest > 0.0))
+          vertex["to"].fail("the direction of an ideal vertex must not be zero");
+        d /= largest;  // no overflow or underflow in its length
+        polygon.vertices.push_back(d / glm::length(d));
+        polygon.ideal.push_back(true);
+      } else {
+        const Vec2 at = vertex.vec2();
+        polygon.vertices.push_back(at);
+        polygon.ideal.push_back(false);
+        scene.scale = std::max({scene.scale, std::abs(at.x), std::abs(at.y)});
+      }
+    }
     scene.polygons.push_back(std::move(polygon));
     vertex_lists.push_back(poly);
   }
@@ -173,6 +188,10 @@ void read_boundaries(const JsonNode& root, Scene& scene) {
     node.allow_keys({"edge", "boundary"});
     const EdgeRef e = read_edge_ref(node["edge"], scene);
     Edge& edge = scene.polygons[static_cast<size_t>(e.polygon)].edges[static_cast<size_t>(e.edge)];
+    if (edge.kind == EdgeKind::infinity)
+      node["edge"].fail("edge " + format_edge(e) +
+                        " lies at infinity (between two ideal vertices): nothing reaches it, so "
+                        "it takes no boundary");
     if (edge.kind == EdgeKind::glued)
       node["edge"].fail("edge " + format_edge(e) + " is glued by /gluings/" +
                         std::to_string(edge.gluing) + "; only unglued edges take a boundary");
@@ -243,7 +262,7 @@ void read_objects(const JsonNode& root, Scene& scene) {
     if (!polygon.contains(c))
       node["center"].fail("the " + where + " has its center outside that polygon");
     for (int i = 0; i < polygon.size(); ++i) {
-      const double d = distance_to_segment(c, polygon.vertex(i), polygon.vertex(i + 1));
+      const double d = polygon.edges[static_cast<size_t>(i)].distance(c);
       if (d <= o.footprint_radius())
         node.fail("the " + where + " reaches edge " + std::to_string(i) +
                   ": its footprint radius " + format_number(o.footprint_radius()) +
@@ -286,9 +305,8 @@ void read_markers(const JsonNode& root, Scene& scene) {
       const int n = polygon.size();
       for (int i = 0; i < n; ++i) {
         const bool incident = i == k.vertex || (i + 1) % n == k.vertex;
-        const double room = incident
-                                ? 0.5 * polygon.edges[static_cast<size_t>(i)].length
-                                : distance_to_segment(at, polygon.vertex(i), polygon.vertex(i + 1));
+        const Edge& edge = polygon.edges[static_cast<size_t>(i)];
+        const double room = incident ? 0.5 * edge.length : edge.distance(at);
         if (r >= room)
           node.fail("radius " + format_number(r) + " is too large: around vertex " +
                     std::to_string(k.vertex) + " of polygon " + std::to_string(k.polygon) +

@@ -117,6 +117,22 @@ const char* to_string(EdgeKind k) {
       return "mirror";
     case EdgeKind::wall:
       return "wall";
+    case EdgeKind::infinity:
+      return "infinity";
+  }
+  return "?";
+}
+
+const char* to_string(EdgeShape s) {
+  switch (s) {
+    case EdgeShape::segment:
+      return "segment";
+    case EdgeShape::ray_out:
+      return "ray_out";
+    case EdgeShape::ray_in:
+      return "ray_in";
+    case EdgeShape::at_infinity:
+      return "at_infinity";
   }
   return "?";
 }

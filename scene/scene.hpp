@@ -34,33 +34,65 @@ struct Gluing {
   GluingType type = GluingType::translation;
 };
 
-enum class EdgeKind { glued, mirror, wall };
+// What an edge does to a ray that reaches it. An edge at infinity (between two ideal vertices,
+// DESIGN.md section 1 "Infinite surfaces") is no wall: nothing reaches it.
+enum class EdgeKind { glued, mirror, wall, infinity };
+
+// Where an edge lies: a segment between finite vertices, a ray from a finite vertex out to an
+// ideal one (ray_out) or in from an ideal one to a finite one (ray_in), or at infinity.
+enum class EdgeShape { segment, ray_out, ray_in, at_infinity };
 
 // One edge of a polygon, with everything a ray crossing it needs.
 struct Edge {
   EdgeKind kind = EdgeKind::mirror;
-  int gluing = -1;   // index into Scene::gluings when glued
-  EdgeRef to;        // destination edge when glued
-  Affine2 map;       // this polygon's coordinates -> to.polygon's coordinates when glued
-  Vec2 normal{0.0};  // outward unit normal
-  double length = 0.0;
+  EdgeShape shape = EdgeShape::segment;
+  int gluing = -1;      // index into Scene::gluings when glued
+  EdgeRef to;           // destination edge when glued
+  Affine2 map;          // this polygon's coordinates -> to.polygon's coordinates when glued
+  Vec2 normal{0.0};     // outward unit normal (0 at infinity)
+  double length = 0.0;  // infinite for rays and at infinity
+  // The points of a segment or ray are start + u along, u in [0, length]: start is the finite
+  // end (a ray_in's is its last vertex), along the unit direction into the edge.
+  Vec2 start{0.0};
+  Vec2 along{0.0};
+
+  bool ray() const { return shape == EdgeShape::ray_out || shape == EdgeShape::ray_in; }
+  // Distance from p to the edge's points (infinite at infinity).
+  double distance(Vec2 p) const;
 };
 
 struct Polygon {
-  std::vector<Vec2> vertices;  // counterclockwise
+  std::vector<Vec2> vertices;  // counterclockwise; an ideal vertex holds its unit direction
+  std::vector<bool> ideal;     // per vertex: the point at infinity in direction vertices[i]
   std::vector<Edge> edges;     // edge i runs from vertex i to vertex i+1 (mod n)
 
+  size_t wrap(int i) const { return static_cast<size_t>(((i % size()) + size()) % size()); }
   int size() const { return static_cast<int>(vertices.size()); }
-  Vec2 vertex(int i) const {
-    return vertices[static_cast<size_t>(((i % size()) + size()) % size())];
-  }
+  // Vertex i's point, or an ideal vertex's direction (is_ideal says which).
+  Vec2 vertex(int i) const { return vertices[wrap(i)]; }
+  bool is_ideal(int i) const { return !ideal.empty() && ideal[wrap(i)]; }
+  // Whether the polygon is unbounded (has an ideal vertex).
+  bool infinite() const;
+  // Infinite for an unbounded polygon.
   double area() const;
+  // The area centroid; of an unbounded polygon, a point inside it a unit of scale in from its
+  // finite vertices' mean, along the middle of its directions to infinity.
   Vec2 centroid() const;
+  // The polygon cut off far out: each ideal vertex replaced by the point `radius` out along its
+  // direction from its finite neighbour (two points when both neighbours are finite), and the
+  // edge at infinity by an arc of points at least every 2pi / arc_steps. A finite polygon is
+  // its vertices. Inside a disc of about radius / 2 it has the unbounded polygon's points.
+  std::vector<Vec2> outline(double radius, int arc_steps = 8) const;
+  // The points of the outline that stand in for the ideal vertices, in order: from the far
+  // point of the ray running out to that of the ray running in. Empty for a finite polygon.
+  std::vector<Vec2> far_points(double radius, int arc_steps = 8) const;
   // Strictly inside, at least `margin` away from every edge.
   bool contains(Vec2 p, double margin = 0.0) const;
   double distance_to_boundary(Vec2 p) const;
   // Interior angle at vertex i, in (0, 2pi).
-  double corner_angle(int i) const;
+  double corner_angle(int i) const;  // of a finite vertex
+  // The direction in which edge i runs (not of unit length; 0 at infinity).
+  Vec2 heading(int i) const;
 
   // Where the path o + s d, s in [0, s_max], first leaves the polygon: through the first edge it
   // crosses outward, at s (0 where it starts within s_tolerance behind the edge's line), or edge
@@ -118,11 +150,14 @@ struct VertexClass {
 
 struct Topology {
   int components = 1;
-  int euler_characteristic = 0;
+  // A polygon with an ideal vertex makes the surface infinite (DESIGN.md section 1): it has no
+  // Euler characteristic or genus.
+  bool infinite = false;
+  std::optional<int> euler_characteristic;
   bool orientable = true;
   int boundary_components = 0;
   // Orientable: the number of handles; non-orientable: the number of cross-caps. Unset when
-  // the scene has more than one component.
+  // the scene has more than one component, or is infinite.
   std::optional<int> genus;
 };
 
@@ -198,6 +233,7 @@ struct Scene {
 
 const char* to_string(GluingType t);
 const char* to_string(EdgeKind k);
+const char* to_string(EdgeShape s);
 const char* to_string(ObjectType t);
 
 }  // namespace flatmarch

@@ -75,12 +75,16 @@ std::vector<InsetVertex> inset_triangles(const Scene& scene, const Camera& camer
   t.quad({box.x, box.y}, {box.x + box.width, box.y}, {box.x + box.width, box.y + box.height},
          {box.x, box.y + box.height}, kBackdrop);
   const Polygon& current = scene.polygons[static_cast<size_t>(camera.polygon)];
+  // Unbounded polygons as the floor plan cuts them off; their edges at infinity are not drawn.
   for (int i = 0; i < current.size(); ++i)
-    t.line(at(current.vertex(i)), at(current.vertex(i + 1)), 5.0, kCurrent);
+    if (const PlanEdge e = plan_edge(current, i, layout.radius()); e.drawn)
+      t.line(at(e.a), at(e.b), 5.0, kCurrent);
   for (const Polygon& polygon : scene.polygons)
     for (int i = 0; i < polygon.size(); ++i) {
       const Edge& edge = polygon.edges[static_cast<size_t>(i)];
-      t.line(at(polygon.vertex(i)), at(polygon.vertex(i + 1)), 2.0,
+      const PlanEdge e = plan_edge(polygon, i, layout.radius());
+      if (!e.drawn) continue;
+      t.line(at(e.a), at(e.b), 2.0,
              edge.kind == EdgeKind::glued    ? gluing_colour(scene.look, edge.gluing)
              : edge.kind == EdgeKind::mirror ? kMirror
                                              : kWall);

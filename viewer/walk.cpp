@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -73,6 +74,13 @@ void walk_rooms(const Scene& scene, Vec2 d, WalkResult& result) {
       break;
     }
     const Polygon& polygon = scene.polygons[static_cast<size_t>(camera.polygon)];
+    if (const double reach = kWalkReach * scene.scale;
+        polygon.infinite() && glm::length(o) + glm::length(d) > reach) {
+      // No further than kWalkReach from the origin (the triangle inequality keeps o + d within).
+      d *= std::max(reach - glm::length(o), 0.0) / glm::length(d);
+      result.blocked = true;
+      if (d == Vec2(0.0)) break;
+    }
     // Where the path o + s d, s in [0, 1], first leaves the room.
     const Polygon::Exit exit =
         polygon.exit(o, d, vertex_radius, vertex_radius / glm::length(d), 1.0);
@@ -86,8 +94,12 @@ void walk_rooms(const Scene& scene, Vec2 d, WalkResult& result) {
     }
     const Edge& edge = polygon.edges[static_cast<size_t>(exit.edge)];
     const Vec2 at = o + exit.s * d;
-    if (std::min(glm::length(at - polygon.vertex(exit.edge)),
-                 glm::length(at - polygon.vertex(exit.edge + 1))) <= vertex_radius) {
+    // Near a vertex (a ray's finite end; no walk reaches a point at infinity).
+    const double to_vertex =
+        std::min(glm::length(at - edge.start),
+                 edge.ray() ? std::numeric_limits<double>::infinity()
+                            : glm::length(at - (edge.start + edge.length * edge.along)));
+    if (to_vertex <= vertex_radius) {
       o += std::max(exit.s - kWalkMargin / glm::length(d), 0.0) * d;
       result.blocked = true;
       break;
@@ -105,8 +117,7 @@ void walk_rooms(const Scene& scene, Vec2 d, WalkResult& result) {
     const Polygon& to = scene.polygons[static_cast<size_t>(edge.to.polygon)];
     const Edge& entry = to.edges[static_cast<size_t>(edge.to.edge)];
     const Vec2 p = edge.map.apply(at);
-    o = p -
-        (glm::dot(p - to.vertex(edge.to.edge), entry.normal) + kPush * scene.scale) * entry.normal;
+    o = p - (glm::dot(p - entry.start, entry.normal) + kPush * scene.scale) * entry.normal;
     d = edge.map.apply_direction((1.0 - exit.s) * d);
     camera.yaw_deg = turned_yaw(scene.gluings[static_cast<size_t>(edge.gluing)], edge.map.linear,
                                 camera.yaw_deg);

@@ -13,13 +13,18 @@ inline constexpr double kWalkMargin = 1e-3;
 // Room segments (the path between two crossings or slides) of one walk at most: the rest of a
 // longer walk is dropped, so that a walk always ends.
 inline constexpr int kMaxSegments = 64;
+// How far from the origin (in units of the scene's scale) a walk may take the walker in an
+// unbounded room (DESIGN.md section 1, "Infinite surfaces"): a walk that would go further stops
+// there. The renderers model such rooms a thousand times further out (kernel::kReach).
+inline constexpr double kWalkReach = 1e6;
 // Pitch is kept within this many degrees of the horizon.
 inline constexpr double kMaxPitchDeg = 89.0;
 
 struct WalkResult {
   Camera camera;
-  int crossings = 0;     // glued edges crossed
-  bool blocked = false;  // a mirror, wall or vertex (or kMaxSegments) cut the walk short
+  int crossings = 0;  // glued edges crossed
+  // A mirror, wall or vertex (or kMaxSegments, or kWalkReach) cut the walk short.
+  bool blocked = false;
 };
 
 // Moves `camera` by `forward` and `right` horizontally, in its yaw frame (forward = (cos a,

@@ -30,6 +30,7 @@ VertexMeet find_vertex(const Polygon& polygon, Vec2 o, Vec2 dh, double limit) {
   if (dh2 == 0.0) return meet;
   const double dh_len = std::sqrt(dh2);
   for (int k = 0; k < polygon.size(); ++k) {
+    if (polygon.is_ideal(k)) continue;  // no ray reaches a point at infinity
     const Vec2 w = polygon.vertex(k) - o;
     const double s = glm::dot(w, dh) / dh2;
     if (s <= 0.0 || s > limit + kVertexTolerance / dh_len || s >= meet.t) continue;
@@ -195,6 +196,8 @@ class Tracer {
         p_ = edge.to.polygon;
         break;
       }
+      case EdgeKind::infinity:  // never an exit: its normal is 0
+        return finish(EventKind::max_distance, kHitMaxDistance, params_.max_distance - t_, -1);
     }
     ++out_.end.crossings;
     return false;
