@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "backends/oracle/oracle.hpp"
@@ -21,10 +22,11 @@ namespace fs = std::filesystem;
 
 struct Surface {
   std::vector<double> cone_angles_over_pi;  // of the singular vertex classes, ascending
-  int euler_characteristic;
+  std::optional<int> euler_characteristic;  // none for an infinite surface
   bool orientable;
-  int genus;  // handles, or cross-caps when non-orientable
+  std::optional<int> genus;  // handles, or cross-caps when non-orientable
   int boundary_components;
+  bool infinite = false;
 };
 
 // Translation surfaces of genus 2 with one cone point of 6 pi (Gauss-Bonnet: 2 pi - 6 pi =
@@ -64,6 +66,15 @@ const std::map<std::string, Surface>& expected() {
       {"mirror_triangle_1rad", mirror_room({1.0 / kPi, 0.5, 0.5 - 1.0 / kPi})},
       {"mirror_triangle_30_60_90", mirror_room({1.0 / 6, 1.0 / 3, 0.5})},
       {"mirror_triangle_equilateral", mirror_room({1.0 / 3, 1.0 / 3, 1.0 / 3})},
+      // Infinite surfaces (DESIGN.md section 1): a cone's one cone point has the angle of its
+      // wedge, or of its two wedges; a cylinder's one vertex class is regular: two right angles
+      // on the half-cylinder's wall (a boundary class of angle pi), four without one.
+      {"cone_half_pi", {{0.5}, std::nullopt, true, std::nullopt, 0, true}},
+      {"cone_pi", {{1.0}, std::nullopt, true, std::nullopt, 0, true}},
+      {"cone_three_half_pi", {{1.5}, std::nullopt, true, std::nullopt, 0, true}},
+      {"cone_three_pi", {{3.0}, std::nullopt, true, std::nullopt, 0, true}},
+      {"half_cylinder", {{}, std::nullopt, true, std::nullopt, 1, true}},
+      {"cylinder", {{}, std::nullopt, true, std::nullopt, 0, true}},
   };
   return table;
 }
@@ -105,6 +116,54 @@ TEST(Gallery, AffineMapsAreTheMatricesGiven) {
   }
 }
 
+// The infinite surfaces' gluings, by hand from DESIGN.md section 1: rays are glued with the
+// finite end of one going to that of the other and the direction of one's ideal vertex to that
+// of the other's. A cone's wedge from direction 0 to direction theta has its ray along 0 (edge
+// 0) glued to its ray along theta (edge 2) by the rotation by theta about the apex.
+TEST(Gallery, InfiniteSurfacesGlueTheirRaysByHand) {
+  struct Want {
+    const char* scene;
+    int gluing;
+    double rotation;  // radians
+    Vec2 translation;
+    GluingType type;
+  };
+  const Want wants[] = {
+      {"cone_half_pi", 0, kPi / 2, {0, 0}, GluingType::rotation},
+      {"cone_pi", 0, kPi, {0, 0}, GluingType::half_translation},
+      {"cone_three_half_pi", 0, 3 * kPi / 2, {0, 0}, GluingType::rotation},
+      // Wedge 0's ray along -y (edge 2) to wedge 1's ray along +x (edge 0): -y turns to +x by a
+      // quarter turn; and wedge 1's to wedge 0's likewise.
+      {"cone_three_pi", 0, kPi / 2, {0, 0}, GluingType::rotation},
+      {"cone_three_pi", 1, kPi / 2, {0, 0}, GluingType::rotation},
+      // The half-strip's right side (3,0) up to its left side coming down to (0,0): (3,0) goes to
+      // (0,0), a translation by (-3, 0).
+      {"half_cylinder", 0, 0, {-3, 0}, GluingType::translation},
+      // The two half-strips share the base segment (0,0)-(3,0) as it lies: the identity.
+      {"cylinder", 0, 0, {0, 0}, GluingType::translation},
+      {"cylinder", 1, 0, {-3, 0}, GluingType::translation},
+      // The lower half-strip's ray down from (0,0) to its ray up to (3,0): by (3, 0).
+      {"cylinder", 2, 0, {3, 0}, GluingType::translation},
+  };
+  for (const Want& w : wants) {
+    SCOPED_TRACE(std::string(w.scene) + " gluing " + std::to_string(w.gluing));
+    const Scene& s = test::gallery_scene(w.scene);
+    EXPECT_TRUE(s.topology.infinite);
+    EXPECT_FALSE(s.topology.euler_characteristic.has_value());
+    EXPECT_FALSE(s.topology.genus.has_value());
+    const Gluing& g = s.gluings[static_cast<size_t>(w.gluing)];
+    EXPECT_EQ(g.type, w.type);
+    const Mat2 want(Vec2(std::cos(w.rotation), std::sin(w.rotation)),
+                    Vec2(-std::sin(w.rotation), std::cos(w.rotation)));
+    for (int c = 0; c < 2; ++c)
+      for (int r = 0; r < 2; ++r) EXPECT_NEAR(g.g.linear[c][r], want[c][r], 1e-12);
+    EXPECT_NEAR(g.g.translation.x, w.translation.x, 1e-12);
+    EXPECT_NEAR(g.g.translation.y, w.translation.y, 1e-12);
+  }
+  // The finite scenes are not infinite.
+  EXPECT_FALSE(test::gallery_scene("torus").topology.infinite);
+}
+
 class GalleryScene : public testing::TestWithParam<fs::path> {};
 
 TEST_P(GalleryScene, HasTheStructureOfItsSurface) {
@@ -124,6 +183,7 @@ TEST_P(GalleryScene, HasTheStructureOfItsSurface) {
   EXPECT_EQ(s.topology.orientable, want.orientable);
   EXPECT_EQ(s.topology.genus, want.genus);
   EXPECT_EQ(s.topology.boundary_components, want.boundary_components);
+  EXPECT_EQ(s.topology.infinite, want.infinite);
   EXPECT_FALSE(s.description.empty());
   // Each has the paper's test object.
   EXPECT_TRUE(std::any_of(s.objects.begin(), s.objects.end(),

@@ -2,8 +2,10 @@
 // closed mirror orbits, great circles of the cube, exact intersections.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <random>
 
 #include "backends/oracle/intersect.hpp"
 #include "backends/oracle/oracle.hpp"
@@ -301,6 +303,133 @@ TEST(OracleTransport, ConePointCylinder) {
   // corner (0, 2), which belongs to the cone point too: it hits that corner's sector.
   const OracleResult sector = trace(s, {1, 3, 1}, {-0.95, -1, 0});
   EXPECT_EQ(sector.end.hit, 1);
+}
+
+// ---- Infinite surfaces (DESIGN.md section 1) ---------------------------------------------
+
+// A cone of angle theta: the wedge from direction 0 to direction theta, its rays glued.
+std::string cone_json(double theta) {
+  return R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [)" + std::to_string(std::cos(theta)) +
+         ", " + std::to_string(std::sin(theta)) + R"(]}]], "gluings": [[[0, 0], [0, 2]]]})";
+}
+
+int count(const OracleResult& r, EventKind kind) {
+  return static_cast<int>(std::count_if(r.trace.events.begin(), r.trace.events.end(),
+                                        [&](const Event& e) { return e.kind == kind; }));
+}
+
+TEST(OracleInfinite, ConeRaysCrossWhereTheUnfoldedWedgesPutThem) {
+  // Unfolded, a ray is a straight line p + s d; its polar angle about the apex runs from that of
+  // p by the signed angle delta from p to d, |delta| < pi, and it crosses a glued ray each time
+  // that angle passes a multiple of the wedge's angle: at most ceil(pi / theta) times. The
+  // crossing with the copy of the ray at angle a is where cross(p + s d, (cos a, sin a)) = 0,
+  // at distance |p + s d| from the apex on the glued ray. After it the ray runs out to
+  // max_distance.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const double theta : {kPi / 3, kPi / 2, 2 * kPi / 3, kPi, 1.2 * kPi, 3 * kPi / 2}) {
+    SCOPED_TRACE("theta " + std::to_string(theta));
+    const Scene s = load(cone_json(theta));
+    // The cone angle, the wedge's, parsed from six decimals.
+    ASSERT_EQ(s.vertex_classes.size(), 1u);
+    EXPECT_NEAR(s.vertex_classes[0].cone_angle, theta, 1e-6);
+    const double wedge = s.vertex_classes[0].cone_angle;
+    int most = 0;
+    for (int n = 0; n < 200; ++n) {
+      const double phi0 = wedge * (0.05 + 0.9 * unit(random)), r0 = 0.5 + 3.0 * unit(random);
+      const Vec2 p = r0 * Vec2(std::cos(phi0), std::sin(phi0));
+      const double heading = 2.0 * kPi * unit(random);
+      const Vec2 d(std::cos(heading), std::sin(heading));
+      const double delta = std::atan2(cross(p, d), glm::dot(p, d));
+      if (std::abs(std::abs(delta) - kPi) < 1e-3) continue;  // aimed at the apex
+      std::vector<double> by_hand;  // path lengths of the crossings, in order
+      for (int k = -8; k <= 8; ++k) {
+        const double a = k * wedge;
+        if ((a - phi0) * (a - phi0 - delta) >= 0.0) continue;  // not passed
+        const Vec2 u(std::cos(a), std::sin(a));
+        const double at = -cross(p, u) / cross(d, u);
+        if (at < MarchParams{}.max_distance) by_hand.push_back(at);  // else beyond the end
+      }
+      std::sort(by_hand.begin(), by_hand.end());
+      const OracleResult r = trace(s, Vec3(p, 1.0), Vec3(d, 0.0));
+      std::vector<const Event*> crossings;
+      for (const Event& e : r.trace.events)
+        if (e.kind == EventKind::gluing) crossings.push_back(&e);
+      ASSERT_EQ(crossings.size(), by_hand.size()) << "ray " << n;
+      for (size_t k = 0; k < by_hand.size(); ++k) {
+        EXPECT_NEAR(crossings[k]->t, by_hand[k], 1e-9);
+        EXPECT_NEAR(glm::length(Vec2(crossings[k]->at)), glm::length(p + by_hand[k] * d), 1e-9);
+      }
+      most = std::max(most, static_cast<int>(by_hand.size()));
+      EXPECT_LE(static_cast<int>(by_hand.size()), static_cast<int>(std::ceil(kPi / theta - 1e-9)));
+      EXPECT_EQ(r.end.hit, kHitMaxDistance) << "ray " << n;
+      EXPECT_NEAR(r.end.t, MarchParams{}.max_distance, 1e-9);
+    }
+    // Some rays cross as often as the bound allows.
+    EXPECT_EQ(most, static_cast<int>(std::ceil(kPi / theta - 1e-9)));
+  }
+}
+
+TEST(OracleInfinite, ARayAimedAtTheApexEndsThere) {
+  const Scene s = load(cone_json(kPi / 2));
+  const OracleResult r = trace(s, {1, 1, 1}, {-1, -1, 0});
+  EXPECT_EQ(r.end.hit, kHitVertex);
+  EXPECT_NEAR(r.end.t, std::sqrt(2.0), 1e-9);
+  EXPECT_EQ(count(r, EventKind::gluing), 0);
+}
+
+TEST(OracleInfinite, TwoWedgesMakeAConeOf3Pi) {
+  // Wedges of 3 pi / 2, each one's ray along -y glued to the other's along +x: a straight line
+  // sweeps less than pi about the apex, so it crosses once at most, into the other wedge.
+  const Scene s = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, -1]}],
+                                        [[0, 0], {"to": [1, 0]}, {"to": [0, -1]}]],
+                           "gluings": [[[0, 2], [1, 0]], [[1, 2], [0, 0]]]})");
+  ASSERT_EQ(s.vertex_classes.size(), 1u);
+  EXPECT_NEAR(s.vertex_classes[0].cone_angle, 3 * kPi, 1e-12);
+  // From (-1, -1) (angle 5 pi / 4) along +x: crosses the ray along -y at (0, -1), t = 1, into
+  // wedge 1 at its ray along +x, (1, 0) (the quarter turn), then runs on along +y.
+  const OracleResult r = trace(s, {-1, -1, 1}, {1, 0, 0});
+  ASSERT_EQ(count(r, EventKind::gluing), 1);
+  expect_gluing(r.trace.events[0], 0, 2, 1, 0, 1.0, {0, -1, 1});
+  EXPECT_EQ(r.end.polygon, 1);
+  expect_near(r.end.at, {1, MarchParams{}.max_distance - 1.0, 1});
+}
+
+TEST(OracleInfinite, CylinderRaysCrossItsGluedRaysKTimesAUnitOfY) {
+  // Circumference 1: along (k, 1) from (0.5, 0.5) the unfolded line meets x = m at
+  // y = 0.5 + (m - 0.5) / k, on the right ray (edge 1) at (1, y): k crossings a unit of y.
+  const Scene s = load(R"({"polygons": [[[0, 0], [1, 0], {"to": [0, 1]}, {"to": [0, 1]}]],
+                           "gluings": [[[0, 1], [0, 3]]]})");
+  for (const int k : {1, 2, 3, 5}) {
+    SCOPED_TRACE("k " + std::to_string(k));
+    const double length = std::hypot(k, 1.0);
+    MarchParams params;
+    params.max_distance = 10.0 * length;  // 10 units of y
+    const OracleResult r = trace(s, {0.5, 0.5, 1}, {k, 1, 0}, 0, params);
+    ASSERT_EQ(count(r, EventKind::gluing), 10 * k);
+    for (int m = 1; m <= 10 * k; ++m) {
+      const double y = 0.5 + (m - 0.5) / k;
+      expect_gluing(r.trace.events[static_cast<size_t>(m - 1)], 0, 1, 0, 3, (y - 0.5) * length,
+                    {1, y, 1});
+    }
+    EXPECT_EQ(r.end.hit, kHitMaxDistance);
+  }
+}
+
+TEST(OracleInfinite, NothingCrossesTheEdgeAtInfinity) {
+  // The half-strip's edge at infinity is edge 2: a ray straight up the strip never meets it,
+  // and the base below is a mirror (the default boundary).
+  const Scene s = load(R"({"polygons": [[[0, 0], [1, 0], {"to": [0, 1]}, {"to": [0, 1]}]],
+                           "gluings": [[[0, 1], [0, 3]]]})");
+  EXPECT_EQ(s.polygons[0].edges[2].kind, EdgeKind::infinity);
+  const OracleResult up = trace(s, {0.5, 0.5, 1}, {0, 1, 0});
+  EXPECT_EQ(up.end.hit, kHitMaxDistance);
+  EXPECT_TRUE(up.trace.events.size() == 1);
+  // Straight down: the mirror at y = 0, 0.5 away, turns it back up, and it runs out 99.5 up.
+  const OracleResult down = trace(s, {0.5, 0.5, 1}, {0, -1, 0});
+  EXPECT_EQ(count(down, EventKind::mirror), 1);
+  EXPECT_EQ(down.end.hit, kHitMaxDistance);
+  expect_near(down.end.at, {0.5, MarchParams{}.max_distance - 0.5, 1});
 }
 
 TEST(Intersect, EachSolidExactly) {

@@ -254,6 +254,84 @@ TEST(Polygon, NonConvexL) {
   EXPECT_NEAR(l.distance_to_boundary({2.5, 2.5}), 0.5, 1e-12);
 }
 
+TEST(Polygon, UnboundedWedgeOfThreeQuarterTurns) {
+  // The non-convex wedge from the ray along +x counterclockwise to the ray along -y: every point
+  // but the quarter x > 0, y < 0.
+  const Scene s = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, -1]}]]})");
+  const Polygon& w = s.polygons[0];
+  EXPECT_TRUE(w.infinite());
+  EXPECT_TRUE(w.is_ideal(1) && w.is_ideal(2) && !w.is_ideal(0));
+  EXPECT_EQ(w.edges[0].shape, EdgeShape::ray_out);
+  EXPECT_EQ(w.edges[1].shape, EdgeShape::at_infinity);
+  EXPECT_EQ(w.edges[1].kind, EdgeKind::infinity);
+  EXPECT_EQ(w.edges[2].shape, EdgeShape::ray_in);
+  expect_near(w.edges[0].normal, {0, -1});  // outward: below the ray along +x
+  expect_near(w.edges[2].normal, {1, 0});   // right of the ray coming up the -y axis
+  EXPECT_NEAR(w.corner_angle(0), 1.5 * kPi, 1e-12);
+  EXPECT_TRUE(std::isinf(w.area()));
+  EXPECT_TRUE(w.contains({1, 1}));
+  EXPECT_TRUE(w.contains({-1e6, -1e6}));
+  EXPECT_TRUE(w.contains({1e6, 1e-3}));
+  EXPECT_FALSE(w.contains({1, -1}));
+  EXPECT_FALSE(w.contains({1e6, -1e-3}));
+  EXPECT_TRUE(w.contains(w.centroid()));
+  // Distances to half-lines: beyond the apex a ray's nearest point is the apex.
+  EXPECT_NEAR(w.distance_to_boundary({5, 2}), 2.0, 1e-12);
+  EXPECT_NEAR(w.distance_to_boundary({-3, 4}), 5.0, 1e-12);
+  EXPECT_NEAR(w.distance_to_boundary({-2, -7}), 2.0, 1e-12);
+  // A path leaves through a ray, never through the edge at infinity.
+  const Polygon::Exit down = w.exit({5, 2}, {0, -1}, 1e-9, 1e-9);
+  EXPECT_EQ(down.edge, 0);
+  EXPECT_NEAR(down.s, 2.0, 1e-12);
+  const Polygon::Exit away = w.exit({5, 2}, {1, 1}, 1e-9, 1e-9);
+  EXPECT_EQ(away.edge, -1);
+  EXPECT_TRUE(std::isinf(away.s));
+  // Cut off at radius 10: the apex, (10, 0), an arc about the apex at least every 45 degrees,
+  // and (0, -10).
+  const std::vector<Vec2> outline = w.outline(10.0);
+  ASSERT_EQ(outline.size(), 1u + 7u);
+  expect_near(outline[1], {10, 0});
+  expect_near(outline[3], {0, 10});
+  expect_near(outline[5], {-10, 0});
+  expect_near(outline.back(), {0, -10});
+}
+
+TEST(Polygon, HalfStripWithOneIdealVertex) {
+  // One ideal vertex: the two rays beside it run the same way, and there is no edge at
+  // infinity. The half-strip 0 < x < 1, y > 0.
+  const Scene s = load(R"({"polygons": [[[0, 0], [1, 0], {"to": [0, 1]}]]})");
+  const Polygon& h = s.polygons[0];
+  EXPECT_EQ(h.edges[1].shape, EdgeShape::ray_out);
+  EXPECT_EQ(h.edges[2].shape, EdgeShape::ray_in);
+  EXPECT_NEAR(h.corner_angle(0), kPi / 2, 1e-12);
+  EXPECT_NEAR(h.corner_angle(1), kPi / 2, 1e-12);
+  EXPECT_TRUE(h.contains({0.5, 1e5}));
+  EXPECT_FALSE(h.contains({1.5, 1e5}));
+  EXPECT_FALSE(h.contains({0.5, -0.1}));
+  expect_near(h.centroid(), {0.5, 1.0});
+  // Two mirrors running to infinity and the base: one boundary, no Euler characteristic.
+  EXPECT_TRUE(s.topology.infinite);
+  EXPECT_FALSE(s.topology.euler_characteristic);
+  EXPECT_EQ(s.topology.boundary_components, 1);
+}
+
+TEST(GluingMap, RaysGluedByAReflection) {
+  // Two wedges of a right angle glued along their rays along +x, which both run out to
+  // infinity: "map": "reflection" takes (0,0) to (0,0) and +x to +x, the reflection in the
+  // x-axis.
+  const Scene s = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, 1]}],
+                                        [[0, 0], {"to": [1, 0]}, {"to": [0, 1]}]],
+                           "gluings": [{"edges": [[0, 0], [1, 0]], "map": "reflection"}]})");
+  const Gluing& g = s.gluings[0];
+  EXPECT_EQ(g.type, GluingType::reflection);
+  EXPECT_NEAR(g.g.linear[0][0], 1.0, 1e-12);
+  EXPECT_NEAR(g.g.linear[1][1], -1.0, 1e-12);
+  EXPECT_NEAR(glm::length(g.g.translation), 0.0, 1e-12);
+  // A reversing gluing between two rooms leaves them orientable, as one piece.
+  EXPECT_TRUE(s.topology.orientable);
+  EXPECT_EQ(s.topology.components, 1);
+}
+
 TEST(Objects, FootprintsAndDefaults) {
   const Scene s = load(test::torus_json(R"("objects": [
       {"type": "hollow_cube", "center": [1, 1, 1], "size": 0.2},

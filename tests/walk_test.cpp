@@ -3,6 +3,7 @@
 // its angle, mirrors and vertices stop it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -98,6 +99,63 @@ TEST(Walk, LoopRoundACubeCornerTurnsTheWalkerByTheAngleDeficit) {
   EXPECT_NEAR(
       std::remainder(r.camera.yaw_deg - start.yaw_deg - (2.0 * kPi - cone) * 180.0 / kPi, 360.0),
       0.0, kTol);
+}
+
+TEST(Walk, OnceRoundAnInfiniteConesApexTurnsTheWalkerBy2PiLessItsAngle) {
+  // The gallery's infinite cones: wedges from direction 0 to their angle, glued along their rays
+  // by rotations about the apex (DESIGN.md section 1). The walker keeps its yaw and steps along
+  // chords of the circle of radius 1.5 about the apex, 10 degrees of polar angle at a time in
+  // the coordinates of the room it is in (a chord that runs past a glued ray continues into the
+  // next wedge, as unfolding lays it out). Once round, the polar angles swept add up to the cone
+  // angle, and it is back where it started, turned by the gluings' rotations: 2 pi - theta.
+  for (const char* name : {"cone_half_pi", "cone_pi", "cone_three_half_pi", "cone_three_pi"}) {
+    SCOPED_TRACE(name);
+    const Scene& s = gallery(name);
+    ASSERT_EQ(s.vertex_classes.size(), 1u);
+    const double theta = s.vertex_classes[0].cone_angle;
+    const double wedge = s.polygons[0].corner_angle(0);
+    const double radius = 1.5, z = 1.0;
+    const Camera start = at(0, {radius * std::cos(wedge / 2), radius * std::sin(wedge / 2), z}, 20);
+    Camera c = start;
+    const int steps = static_cast<int>(std::lround(theta / (kPi / 18)));
+    const double step = theta / steps;
+    int crossings = 0;
+    for (int k = 0; k < steps; ++k) {
+      const Vec2 p(c.position);
+      double phi = std::atan2(p.y, p.x);
+      if (phi < 0) phi += 2 * kPi;
+      const Vec2 v = radius * Vec2(std::cos(phi + step), std::sin(phi + step)) - p;
+      const double a = c.yaw_deg * kPi / 180;
+      const WalkResult r = walk(s, c, glm::dot(v, Vec2(std::cos(a), std::sin(a))),
+                                glm::dot(v, Vec2(std::sin(a), -std::cos(a))), 0);
+      ASSERT_FALSE(r.blocked) << "step " << k;
+      ASSERT_LE(r.crossings, 1);
+      crossings += r.crossings;
+      c = r.camera;
+      EXPECT_NEAR(glm::length(Vec2(c.position)), radius, 1e-6) << "step " << k;
+    }
+    EXPECT_EQ(crossings, static_cast<int>(s.polygons.size()));  // each wedge's glued ray once
+    expect_at(c, start.polygon, start.position, 1e-6);
+    EXPECT_NEAR(std::remainder(c.yaw_deg - start.yaw_deg - (2 * kPi - theta) * 180 / kPi, 360.0),
+                0.0, 1e-9);
+  }
+}
+
+TEST(Walk, InfiniteCylinderAndTheEdgeOfTheModelledWorld) {
+  // cylinder.json: circumference 3, the strip above y = 0 and the one below glued along it.
+  // Walking down across y = 0 enters the lower half-strip; walking round (east by 3) comes back.
+  const Scene& s = gallery("cylinder");
+  WalkResult r = walk(s, at(0, {1.5, 1, 1}, -90), 2, 0, 0);
+  expect_at(r.camera, 1, {1.5, -1, 1}, kCrossTol);
+  EXPECT_EQ(r.crossings, 1);
+  r = walk(s, r.camera, 0, -3, 0);  // facing -y, left is +x
+  expect_at(r.camera, 1, {1.5, -1, 1}, kCrossTol);
+  EXPECT_EQ(r.crossings, 1);
+  // Far up the tube the walk stops where the rooms are modelled to (kWalkReach).
+  r = walk(s, at(0, {1.5, 1, 1}, 90), 1e12, 0, 0);
+  EXPECT_TRUE(r.blocked);
+  EXPECT_LT(r.camera.position.y, 1e7);
+  EXPECT_TRUE(s.polygons[0].contains(Vec2(r.camera.position)));
 }
 
 TEST(Walk, KleinBottleReflectionMirrorsTheYaw) {
