@@ -11,13 +11,20 @@
 namespace flatmarch::reports {
 
 const std::vector<std::string>& surface_types() {
-  static const std::vector<std::string> types = {"prism",      "mirror",   "dilation",
-                                                 "reflection", "rotation", "translation"};
+  static const std::vector<std::string> types = {
+      "prism", "cone", "cylinder", "mirror", "dilation", "reflection", "rotation", "translation"};
   return types;
 }
 
 std::string surface_type(const Scene& scene) {
   if (scene.period) return "prism";
+  const auto any_gluing = [&](std::initializer_list<GluingType> types) {
+    return std::any_of(scene.gluings.begin(), scene.gluings.end(), [&](const Gluing& g) {
+      return std::find(types.begin(), types.end(), g.type) != types.end();
+    });
+  };
+  if (scene.topology.infinite)
+    return any_gluing({GluingType::rotation, GluingType::half_translation}) ? "cone" : "cylinder";
   const auto any_edge = [&](EdgeKind kind) {
     return std::any_of(scene.polygons.begin(), scene.polygons.end(), [&](const Polygon& p) {
       return std::any_of(p.edges.begin(), p.edges.end(),
@@ -25,11 +32,6 @@ std::string surface_type(const Scene& scene) {
     });
   };
   if (any_edge(EdgeKind::mirror)) return "mirror";
-  const auto any_gluing = [&](std::initializer_list<GluingType> types) {
-    return std::any_of(scene.gluings.begin(), scene.gluings.end(), [&](const Gluing& g) {
-      return std::find(types.begin(), types.end(), g.type) != types.end();
-    });
-  };
   if (any_gluing({GluingType::similarity, GluingType::affine})) return "dilation";
   if (any_gluing({GluingType::reflection})) return "reflection";
   if (any_gluing({GluingType::rotation, GluingType::half_translation})) return "rotation";

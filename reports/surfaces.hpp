@@ -11,6 +11,9 @@ namespace flatmarch::reports {
 
 // The kinds of surface whose rays meet different hazards, in the order the report lists them:
 //   prism        a translation prism (z periodic): rays never escape, paths are long;
+//   cone         an infinite surface with a rotation: rays pass a cone point and run out to
+//                infinity (max_distance);
+//   cylinder     an infinite surface of translations: rays run round it or out along it;
 //   mirror       a billiard table: mirror edges, rays reflect;
 //   dilation     similarity gluings: directions and lengths change at a crossing;
 //   reflection   non-orientable gluings (the Klein bottle);

@@ -332,6 +332,24 @@ TEST(GluingMap, RaysGluedByAReflection) {
   EXPECT_EQ(s.topology.components, 1);
 }
 
+TEST(VertexClasses, InfiniteSeedScenes) {
+  // tests/data/infinite: a mirror wedge of pi/3 is a boundary cone point of its corner angle;
+  // two quarter-planes glued along their rays by a reflection share their apex, pi in all, on
+  // their walls: a regular boundary point.
+  const std::string dir = FLATMARCH_SOURCE_DIR "/tests/data/infinite/";
+  const Scene wedge = load_scene(dir + "mirror_wedge.json");
+  ASSERT_EQ(wedge.vertex_classes.size(), 1u);
+  EXPECT_NEAR(wedge.vertex_classes[0].cone_angle, kPi / 3, 1e-12);
+  EXPECT_TRUE(wedge.vertex_classes[0].boundary && wedge.vertex_classes[0].singular);
+  const Scene glued = load_scene(dir + "rays_glued_by_reflection.json");
+  ASSERT_EQ(glued.vertex_classes.size(), 1u);
+  EXPECT_NEAR(glued.vertex_classes[0].cone_angle, kPi, 1e-12);
+  EXPECT_FALSE(glued.vertex_classes[0].singular);
+  const Scene strip = load_scene(dir + "strip_one_ideal_vertex.json");
+  EXPECT_EQ(strip.gluings[0].type, GluingType::translation);
+  EXPECT_NEAR(strip.gluings[0].g.translation.x, -2.0, 1e-12);
+}
+
 TEST(Objects, FootprintsAndDefaults) {
   const Scene s = load(test::torus_json(R"("objects": [
       {"type": "hollow_cube", "center": [1, 1, 1], "size": 0.2},

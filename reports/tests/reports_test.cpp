@@ -30,6 +30,11 @@ TEST(SurfaceType, ClassifiesTheGalleryByItsHazards) {
   EXPECT_EQ(surface_type(gallery("klein_bottle")), "reflection");
   EXPECT_EQ(surface_type(gallery("mirror_square")), "mirror");
   EXPECT_EQ(surface_type(gallery("torus_prism")), "prism");
+  EXPECT_EQ(surface_type(gallery("cone_three_pi")), "cone");
+  EXPECT_EQ(surface_type(gallery("cone_pi")), "cone");
+  EXPECT_EQ(surface_type(gallery("half_cylinder")), "cylinder");
+  EXPECT_EQ(surface_type(gallery("cylinder")), "cylinder");
+  EXPECT_EQ(surface_type(gallery("affine_torus")), "dilation");
   EXPECT_EQ(surface_type(load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "conformance" / "scenes" /
                                     "dilation.json")),
             "dilation");
