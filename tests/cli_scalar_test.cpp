@@ -50,6 +50,24 @@ TEST(CliScalar, RendersAndTracesEveryGalleryScene) {
   fs::remove_all(dir);
 }
 
+TEST(CliScalar, WarnsOfAnEpsBelowFloat32sResolutionAtAnInfiniteScenesReach) {
+  // eps 1e-6 is above 2^-23 x the torus's scale (4), below 2^-23 x (3 + max_distance 100), how
+  // far out a ray along the cylinder meets its walls.
+  const auto run = [](const std::string& scene) {
+    return test::run_flatmarch({"render", FLATMARCH_SOURCE_DIR "/scenes/" + scene + ".json", "-o",
+                                testing::TempDir() + "/resolution_" + scene + ".png", "--size",
+                                "16x9", "--backend", "scalar", "--method", "sphere", "--eps",
+                                "1e-6", "--offset", "1e-4"});
+  };
+  const auto torus = run("torus"), cylinder = run("cylinder");
+  ASSERT_EQ(torus.exit_code, 0) << torus.err;
+  ASSERT_EQ(cylinder.exit_code, 0) << cylinder.err;
+  EXPECT_EQ(torus.err.find("float32's resolution"), std::string::npos) << torus.err;
+  EXPECT_NE(cylinder.err.find("below float32's resolution at this scene's reach"),
+            std::string::npos)
+      << cylinder.err;
+}
+
 TEST(CliScalar, WarnsThatOffsetNotAboveEpsPingPongs) {
   const std::string torus = FLATMARCH_SOURCE_DIR "/scenes/torus.json";
   const auto r =

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
+#include <stdexcept>
 
 #include "backends/oracle/oracle.hpp"
 #include "backends/scalar/scalar.hpp"
@@ -83,6 +85,73 @@ TEST(SceneCompiler, MarkersBecomeCylindersAtTheirCorners) {
     EXPECT_EQ(t.objects[static_cast<size_t>(k)].shape, glm::vec4(0.25f, 1.0f, 0, 0));
   }
   EXPECT_EQ(glm::vec2(t.objects[2].center), glm::vec2(4, 0));  // the corner of vertex 1
+}
+
+// An unbounded room (DESIGN.md section 1, "Infinite surfaces") is compiled as its outline cut
+// off kFarRadius out: the wedge of three quarter-turns from the ray along +x to the ray along -y
+// has its two rays (finite end first) and its edge at infinity as the first of six far links,
+// the other five after them.
+TEST(SceneCompiler, AnUnboundedRoomIsItsOutlineCutOffFarOut) {
+  const Scene s = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, -1]}]],
+                           "gluings": [[[0, 0], [0, 2]]]})");
+  const auto t = kernel::compile_scene<double>(s, {});
+  EXPECT_EQ(t.features, 0u);
+  ASSERT_EQ(t.polygons.size(), 1u);
+  EXPECT_EQ(t.polygons[0], glm::ivec4(0, 3 + 5, 0, 0));
+  const double far = kernel::kFarRadius;
+  EXPECT_EQ(t.edges[0].segment, glm::dvec4(0, 0, far, 0));
+  EXPECT_EQ(t.edges[0].link, glm::ivec4(kEdgeGlued, 0, 2, 0));
+  EXPECT_EQ(t.edges[2].segment, glm::dvec4(0, 0, 0, -far));  // from the apex, its finite end
+  EXPECT_EQ(t.edges[2].line, glm::dvec4(1, 0, 0, 1 / (far * far)));  // outward normal +x
+  // The links run round the arc at infinity, at least kFarRadius from the apex.
+  for (int k : {1, 3, 4, 5, 6, 7}) {
+    const glm::dvec4 seg = t.edges[static_cast<size_t>(k)].segment;
+    EXPECT_GE(glm::length(glm::dvec2(seg.x, seg.y)), 0.99 * far) << k;
+    EXPECT_EQ(t.edges[static_cast<size_t>(k)].link.x, kEdgeWall) << k;
+  }
+  // A finite scene's tables hold its edges only.
+  EXPECT_EQ(kernel::compile_scene<double>(load(test::torus_json()), {}).edges.size(), 4u);
+  // Rays are kept within kReach of the origin.
+  MarchParams far_off;
+  far_off.max_distance = 2 * kernel::kReach;
+  EXPECT_THROW(kernel::compile_scene<float>(s, far_off), std::invalid_argument);
+  EXPECT_NO_THROW(kernel::compile_scene<float>(load(test::torus_json()), far_off));
+}
+
+// Within reach, the kernel's distance to a ray edge is the distance to the half-line and its
+// exit is the half-line's: the scene model's, in float64 to rounding and in float32 to its
+// resolution at the distances involved.
+TEST(Kernel, RayEdgesAreHalfLinesWithinReach) {
+  const Scene s = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, -1]}]],
+                           "gluings": [[[0, 0], [0, 2]]]})");
+  const Polygon& w = s.polygons[0];
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto check = [&]<typename real>(real tolerance) {
+    const auto t = kernel::compile_scene<real>(s, {});
+    kernel::with_kernel<real>(t, [&](auto& k) {
+      for (int n = 0; n < 300; ++n) {
+        const double r = std::pow(10.0, 3.0 * (unit(random) + 1.0) / 2.0);  // 1 to 1000
+        const Vec2 p = r * Vec2(unit(random), unit(random));
+        if (!w.contains(p)) continue;
+        const auto d = k.wall_distance(0, glm::vec<2, real>(p));
+        EXPECT_NEAR(static_cast<double>(d.d), w.distance_to_boundary(p), tolerance * r) << n;
+        const double angle = kPi * unit(random);
+        const Vec2 dir(std::cos(angle), std::sin(angle));
+        const auto x = k.exit_edge(0, glm::vec<2, real>(p), glm::vec<2, real>(dir));
+        const Polygon::Exit want = w.exit(p, dir, 1e-9, 1e-9);
+        // A far link (edge 1, the edge at infinity, and 3 on) is no exit.
+        EXPECT_EQ(x.edge == 0 || x.edge == 2 ? x.edge : -1, want.edge) << n;
+        if (want.edge >= 0) {
+          EXPECT_NEAR(static_cast<double>(x.s), want.s, tolerance * (r + want.s)) << n;
+        } else {
+          EXPECT_GT(static_cast<double>(x.s), kernel::kReach) << n;
+        }
+      }
+    });
+  };
+  check(1e-12);
+  check(1e-5f);
 }
 
 TEST(ShaderSource, IsValidGlslForEveryFeatureSet) {
