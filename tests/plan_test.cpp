@@ -1,6 +1,8 @@
 // Floor plans: well-formed SVG whose elements sit where the hand-computed layout puts them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -146,6 +148,36 @@ TEST(FloorPlan, MirrorsWallsAndMarkers) {
   std::multiset<std::string> angles;
   for (const Element& e : elements(svg, "cone-angle")) angles.insert(e.text);
   EXPECT_EQ(angles, (std::multiset<std::string>{"π/2", "0.6435 rad", "0.9273 rad"}));
+}
+
+TEST(FloorPlan, UnboundedPolygonsAreCutOffBeyondTheObjectsAndTheCamera) {
+  // cone_half_pi: the quarter-plane wedge with a hollow cube (half-size 0.35) at (2, 1.2) and
+  // the camera at (3.2, 0.9). The farthest of them from the origin is the cube's footprint,
+  // |(2, 1.2)| + 0.35 sqrt 2; the plan cuts the wedge's rays off a quarter beyond it.
+  const Scene s = load_scene(FLATMARCH_SOURCE_DIR "/scenes/cone_half_pi.json");
+  const double radius =
+      1.25 * std::max(std::hypot(2.0, 1.2) + 0.35 * std::sqrt(2.0), std::hypot(3.2, 0.9));
+  EXPECT_NEAR(plan_radius(s), radius, 1e-12);
+  const std::string svg = floor_plan_svg(s, {});
+  ASSERT_TRUE(well_formed(svg));
+  // Two glued rays drawn (from the apex out to the radius), the edge at infinity not at all.
+  const auto glued = elements(svg, "edge glued");
+  ASSERT_EQ(glued.size(), 2u);
+  const PlanLayout layout(s, 800.0);
+  const Vec2 apex = layout.to_pixels({0, 0});
+  for (const Element& e : glued) {
+    const Vec2 a(e.number("x1"), e.number("y1")), b(e.number("x2"), e.number("y2"));
+    EXPECT_NEAR(std::min(glm::length(a - apex), glm::length(b - apex)), 0.0, 0.01);  // pixels
+    EXPECT_NEAR(std::max(glm::length(a - apex), glm::length(b - apex)), layout.to_pixels(radius),
+                0.01);
+  }
+  // The apex is the one cone point, of angle pi/2.
+  const auto labels = elements(svg, "cone-angle");
+  ASSERT_EQ(labels.size(), 1u);
+  EXPECT_EQ(labels[0].text, "π/2");
+  // The picture spans the cut-off wedge: radius plus the 6% margin on each side.
+  EXPECT_NEAR(layout.width(), 800.0, 1e-9);
+  EXPECT_NEAR(layout.to_pixels(radius), 800.0 / 1.12, 1e-6);
 }
 
 TEST(FloorPlanCli, WritesThePlanAndChecksItsArguments) {
