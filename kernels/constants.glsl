@@ -56,6 +56,7 @@ KCONST float kFar = 1e30f;
 // side) and this much ambient light.
 KCONST float kFloorCheck = 0.5f;
 KCONST float kFloorDark = 0.42f;
+KCONST float kFloorFade = 60.0f;  // t / |dz| at which the checks' contrast is halved
 KCONST float kLightX = 0.35f;
 KCONST float kLightY = 0.55f;
 KCONST float kLightZ = 0.758288f;  // sqrt(1 - 0.35^2 - 0.55^2)

@@ -548,7 +548,7 @@ vec3 shade(Ray r) {
   } else if (r.hit == kHitWall) {
     surface = lit(vec3(params.wall), r.normal);
   } else if (r.hit == kHitFloor) {
-    surface = lit(floor_tone(vec2(r.o)) * vec3(params.floor_colour), r.normal);
+    surface = lit(floor_tone(vec2(r.o), r.t, r.d.z) * vec3(params.floor_colour), r.normal);
   }
   if (r.hit >= 0 || r.hit == kHitWall || r.hit == kHitFloor) {
     surface = fogged(surface, fog, r.t, params.fog_distance);

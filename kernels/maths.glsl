@@ -194,10 +194,18 @@ KINLINE vec3 sky_colour(vec3 fog, vec3 sky, vec3 ground, real dz) {
   return fog + k * (select(dz >= real(0), sky, ground) - fog);
 }
 
-// The floor's tone at p: checks kFloorCheck wide, 1 and kFloorDark (DESIGN.md section 1).
-KINLINE real floor_tone(vec2 p) {
+// The floor's tone at p, reached at path length t by a ray whose unit direction falls dz per
+// unit: checks kFloorCheck wide, 1 and kFloorDark (DESIGN.md section 1), their contrast fading
+// towards their mean as a pixel's footprint on the floor grows, about t / |dz| times its angle
+// (to half at t / |dz| = kFloorFade), so that checks smaller than a pixel near the horizon (an
+// infinite floor runs to it) blur rather than alias into moire, while a floor seen from above
+// keeps its checks.
+KINLINE real floor_tone(vec2 p, real t, real dz) {
   real check = floor(p.x / real(kFloorCheck)) + floor(p.y / real(kFloorCheck));
-  return select(mod(check, real(2)) >= real(1), real(kFloorDark), real(1));
+  real tone = select(mod(check, real(2)) >= real(1), real(kFloorDark), real(1));
+  real mean = real(0.5f) * (real(1) + real(kFloorDark));
+  real far = t / (max(abs(dz), real(1e-6f)) * real(kFloorFade));
+  return mean + (tone - mean) / (real(1) + far * far);
 }
 
 // Linear light brought into [0, 1] for display before sRGB encoding: a filmic curve (Narkowicz's

@@ -623,6 +623,25 @@ TEST(OracleRender, AFailedRayIsFogAndShowFailuresPaintsIt) {
   EXPECT_EQ(f.rgb[1], 0.0f);
 }
 
+// The floor's checks (DESIGN.md section 1), by hand: 0.5 wide, light (1) where the sum of the
+// check indices is even, kFloorDark where odd; their contrast halves where a pixel's footprint
+// t / |dz| reaches kFloorFade and vanishes into the mean far beyond, near the horizon.
+TEST(OracleRender, FloorChecksFadeTowardsTheirMeanAsTheyShrinkBelowAPixel) {
+  kernel::Kernel<double, 0u> k;
+  const double dark = kFloorDark, mean = 0.5 * (1.0 + kFloorDark);
+  EXPECT_NEAR(k.floor_tone({0.25, 0.25}, 0.0, -1.0), 1.0, 1e-6);
+  EXPECT_NEAR(k.floor_tone({0.75, 0.25}, 0.0, -1.0), dark, 1e-6);
+  EXPECT_NEAR(k.floor_tone({-0.25, 0.25}, 0.0, -1.0), dark, 1e-6);  // check -1
+  EXPECT_NEAR(k.floor_tone({0.75, 0.75}, 0.0, -1.0), 1.0, 1e-6);
+  // Seen from 2 straight above: nearly full contrast.
+  EXPECT_NEAR(k.floor_tone({0.25, 0.25}, 2.0, -1.0), mean + (1 - mean) / (1 + 1.0 / 900), 1e-6);
+  // t / |dz| = kFloorFade: half the contrast, whether near and steep or far and grazing.
+  EXPECT_NEAR(k.floor_tone({0.75, 0.25}, kFloorFade / 2, -0.5), mean + (dark - mean) / 2, 1e-6);
+  EXPECT_NEAR(k.floor_tone({0.75, 0.25}, 6.0, -6.0 / kFloorFade), mean + (dark - mean) / 2, 1e-6);
+  // 100 away at a grazing 1%: the mean, to 4e-5.
+  EXPECT_NEAR(k.floor_tone({0.25, 0.25}, 100.0, -0.01), mean, 1e-4);
+}
+
 TEST(OracleRender, AovExrRoundTrip) {
   const Scene s = load_scene(FLATMARCH_SOURCE_DIR "/scenes/l_shape.json");
   const Frame f = OracleBackend().render(s, s.camera, 24, 16, {}, {});

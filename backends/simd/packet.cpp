@@ -40,8 +40,9 @@ HWY_INLINE void Shade(const KernelParams& params, const Packet& r, V& red, V& gr
     lane::vec3 colour = lane::vec3(r.sr, r.sg, r.sb);
     colour = lane::select(lane::lane_bool{wall}, lane::vec3(lane::Broadcast(params.wall)), colour);
     if (Any(floor)) {
-      const lane::vec3 tiles = lane::floor_tone(lane::vec2(r.ox, r.oy)) *
-                               lane::vec3(lane::Broadcast(params.floor_colour));
+      const lane::vec3 tiles =
+          lane::floor_tone(lane::vec2(r.ox, r.oy), lane::real(r.t), lane::real(r.dz)) *
+          lane::vec3(lane::Broadcast(params.floor_colour));
       colour = lane::select(lane::lane_bool{floor}, tiles, colour);
     }
     const lane::vec3 seen = lane::fogged(lane::lit(colour, normal), fog, r.t, params.fog_distance);
