@@ -10,11 +10,13 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 #include <variant>
 
 #include "backends/oracle/oracle.hpp"
 #include "backends/simd/simd.hpp"
+#include "kernels/compile.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::cli {
@@ -195,6 +197,14 @@ void warn_about_resolution(const Scene& scene, const MarchParams& params) {
               << resolution
               << "): sphere tracing gets that close to a wall only by landing on it, and many "
                  "rays run out of steps; use --precision f64 or a larger eps\n";
+}
+
+void check_reach(const Scene& scene, const Camera& camera, const MarchParams& params) {
+  try {
+    kernel::check_reach(scene, params.max_distance, Vec2(camera.position));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--max-distance: ") + e.what());
+  }
 }
 
 const Backend& MarchOptions::resolve() {

@@ -84,6 +84,10 @@ void check_march_params(const MarchParams& params);
 // sphere tracing cannot get within eps of a wall but by landing on it.
 void warn_about_resolution(const Scene& scene, const MarchParams& params);
 
+// UsageError (--max-distance) when rays from `camera` would leave the reach to which an unbounded
+// scene is modelled (kernel::check_reach).
+void check_reach(const Scene& scene, const Camera& camera, const MarchParams& params);
+
 // The backend and march parameters of render and trace (DESIGN.md section 3).
 struct MarchOptions {
   std::string backend;  // empty: default_backend

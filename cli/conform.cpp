@@ -85,6 +85,7 @@ void add_conform(CLI::App& app) {
     o->params.precision = parse_precision(o->precision);
     const std::vector<Method> methods = parse_methods(o->methods);
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
+    for (const Scene& scene : scenes) check_reach(scene, scene.camera, o->params);
     if (std::any_of(methods.begin(), methods.end(), [](Method m) { return m != Method::analytic; }))
       for (const Scene& scene : scenes) {
         MarchParams sphere = o->params;

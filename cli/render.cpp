@@ -38,6 +38,7 @@ void add_render(CLI::App& app) {
     const Scene scene = load_scene(o->scene);
     const Camera camera = o->camera.apply(scene);
     warn_about_resolution(scene, o->march.params);
+    check_reach(scene, camera, o->march.params);
     const auto start = std::chrono::steady_clock::now();
     ProgressReporter progress("rendering " + scene.name + " " + o->size + " with " + backend.name(),
                               o->quiet);

@@ -36,6 +36,9 @@ void add_trace(CLI::App& app) {
     if (auto problem = ray_problem(scene, ray))
       throw UsageError("--from/--dir/--polygon: " + *problem);
     ray.dir = glm::normalize(ray.dir);
+    Camera from;
+    from.position = ray.from;
+    check_reach(scene, from, o->march.params);
     const Trace trace = backend.trace(scene, ray, o->march.params, o->max_events);
     std::cout
         << trace_to_json(scene.name, backend.name(), o->march.params.method, ray, trace).dump(2)

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -101,9 +102,9 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
     const std::vector<Vec2> far = polygon.far_points(kFarRadius);
     std::vector<std::pair<Vec2, Vec2>> chain;
     for (size_t k = 0; k + 1 < far.size(); ++k) chain.push_back({far[k], far[k + 1]});
-    const auto far_link = [&](Vec2 a, Vec2 b, Vec2 inward) {
+    const auto far_link = [&](Vec2 a, Vec2 b) {
       typename Tables<real>::EdgeRecord r{};
-      const Vec2 normal = -glm::normalize(inward);
+      const Vec2 normal = -glm::normalize(perp(b - a));  // outward: the room lies on the left
       r.segment = vec4(real(a.x), real(a.y), real(b.x), real(b.y));
       r.line = vec4(real(normal.x), real(normal.y), real(glm::dot(normal, a)),
                     real(1.0 / glm::dot(b - a, b - a)));
@@ -115,7 +116,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
       const Edge& edge = polygon.edges[static_cast<size_t>(i)];
       if (edge.shape == EdgeShape::at_infinity) {
         const auto [a, b] = chain[next_link++];
-        t.edges.push_back(far_link(a, b, perp(b - a)));
+        t.edges.push_back(far_link(a, b));
         continue;
       }
       Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1);
@@ -140,7 +141,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
     }
     for (; next_link < chain.size(); ++next_link) {
       const auto [a, b] = chain[next_link];
-      t.edges.push_back(far_link(a, b, perp(b - a)));
+      t.edges.push_back(far_link(a, b));
     }
     const int edge_count = static_cast<int>(t.edges.size()) - first_edge;
     // The room's solids: its objects, then a cylinder at each corner that carries a marker.
@@ -170,7 +171,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
   k.eps = real(march.eps);
   k.offset = real(march.offset);
   k.max_distance = real(march.max_distance);
-  check_reach(scene, march);
+  check_reach(scene, march.max_distance, Vec2(scene.camera.position));
   k.omega = real(march.omega);
   k.height = real(scene.height);
   k.top = real(top);
@@ -191,18 +192,20 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
   return t;
 }
 
-void check_reach(const Scene& scene, const MarchParams& march) {
+void check_reach(const Scene& scene, double max_distance, Vec2 camera) {
   if (!scene.topology.infinite) return;
-  double camera = 0.0;
+  double reach = glm::length(camera);
   for (const Polygon& polygon : scene.polygons)
     for (int v = 0; v < polygon.size(); ++v)
-      if (!polygon.is_ideal(v)) camera = std::max(camera, glm::length(polygon.vertex(v)));
-  camera = std::max(camera, glm::length(Vec2(scene.camera.position)));
-  if (camera + march.max_distance > kReach)
-    throw std::invalid_argument(
-        "an unbounded scene is modelled out to " + std::to_string(kReach) +
-        " from its origin; the camera's distance from it plus max_distance (" +
-        std::to_string(camera + march.max_distance) + ") must stay within that");
+      if (!polygon.is_ideal(v)) reach = std::max(reach, glm::length(polygon.vertex(v)));
+  reach += max_distance;
+  if (!(reach <= kReach)) {
+    std::ostringstream s;
+    s << "an unbounded scene is modelled out to 2^30 (" << kReach
+      << ") from its origin, and rays from this camera (or the scene's farthest vertex) run out to "
+      << reach << "; lower max_distance";
+    throw std::invalid_argument(s.str());
+  }
 }
 
 glm::dvec4 edge_tint(const Look& look, const Edge& edge) {

@@ -30,9 +30,10 @@ uint scene_features(const Scene& scene);
 inline constexpr double kFarRadius = 0x1p40;
 inline constexpr double kReach = 0x1p30;
 
-// Throws std::invalid_argument if an unbounded scene's camera or max_distance would take rays
-// beyond kReach.
-void check_reach(const Scene& scene, const MarchParams& march);
+// Throws std::invalid_argument if rays from `camera` (or the scene's farthest finite vertex) in
+// an unbounded scene would run beyond kReach within max_distance. compile_scene checks the
+// scene's own camera; a caller that moves the camera checks its own.
+void check_reach(const Scene& scene, double max_distance, Vec2 camera);
 
 // `march.method` must be one the kernel runs (sphere, relaxed, analytic); throws as check_reach.
 template <typename real>

@@ -46,10 +46,6 @@ class UnionFind {
   std::vector<size_t> parent_;
 };
 
-}  // namespace
-
-namespace {
-
 // Whether edges i and j (neither at infinity) of a polygon whose edge table is filled share a
 // point, to within tol: rays are half-lines, exactly.
 bool edges_touch(const Polygon& polygon, int i, int j, double tol) {
@@ -184,9 +180,7 @@ GluingMapResult derive_gluing_map(const Scene& scene, EdgeRef a, EdgeRef b, Glui
           return {{},
                   "a reflection glues two rays running the same way; " + name(a) + " runs " +
                       (ea.shape == EdgeShape::ray_out ? "out to" : "in from") + " infinity and " +
-                      name(b) +
-                      " the other way (drop \"map\" for an "
-                      "isometry)"};
+                      name(b) + " the other way (drop \"map\" for an isometry)"};
         const Vec2 u = ea.along, v = eb.along;
         const Vec2 w = glm::length(u + v) > 1e-6 ? glm::normalize(u + v) : perp(u);
         r.g.linear = 2.0 * glm::outerProduct(w, w) - Mat2(1.0);

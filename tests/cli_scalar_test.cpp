@@ -68,6 +68,24 @@ TEST(CliScalar, WarnsOfAnEpsBelowFloat32sResolutionAtAnInfiniteScenesReach) {
       << cylinder.err;
 }
 
+TEST(CliScalar, AnInfiniteSceneKeepsRaysWithinItsModelledReach) {
+  // Rays in an unbounded room must stay within 2^30 of the origin (kernel::kReach): from the
+  // cone's camera a max_distance of 2e9 would take them beyond, exit 2; on the torus it is fine.
+  const std::string png = testing::TempDir() + "/reach.png";
+  const auto cone = test::run_flatmarch({"render", FLATMARCH_SOURCE_DIR "/scenes/cone_pi.json",
+                                         "-o", png, "--size", "8x4", "--max-distance", "2e9"});
+  EXPECT_EQ(cone.exit_code, 2) << cone.err;
+  EXPECT_NE(cone.err.find("--max-distance: an unbounded scene is modelled out to 2^30"),
+            std::string::npos)
+      << cone.err;
+  const auto torus = test::run_flatmarch({"render", FLATMARCH_SOURCE_DIR "/scenes/torus.json", "-o",
+                                          png, "--size", "8x4", "--max-distance", "2e9"});
+  EXPECT_EQ(torus.exit_code, 0) << torus.err;
+  const auto trace = test::run_flatmarch({"trace", FLATMARCH_SOURCE_DIR "/scenes/cylinder.json",
+                                          "--from", "1,1.1e9,1", "--dir", "0,1,0"});
+  EXPECT_EQ(trace.exit_code, 2) << trace.err;
+}
+
 TEST(CliScalar, WarnsThatOffsetNotAboveEpsPingPongs) {
   const std::string torus = FLATMARCH_SOURCE_DIR "/scenes/torus.json";
   const auto r =
