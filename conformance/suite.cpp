@@ -52,7 +52,68 @@ void add_check(CaseResult& r, const std::string& name, double value, double limi
   r.passed &= passed;
 }
 
+std::string percent(double share) {
+  std::ostringstream s;
+  s.precision(3);
+  s << 100.0 * share << "%";
+  return s.str();
+}
+
+// The verdict of a case whose checks are in. A method's documented failure modes (DESIGN.md
+// section 3): with offset <= eps, sphere and relaxed tracing cross back and forth at every gluing
+// until max_steps; and a ray that needs more than max_steps steps ends with max_steps. A case is
+// at its method's limit when every check it fails is one that rays out of steps fail, by no
+// more than those rays account for: hit and crossings agreement short of the threshold by at
+// most the stuck share, colour off on at most that many more pixels (a stuck ray is shaded as
+// fog), the step distribution (stuck rays take max_steps).
+void judge(CaseResult& r) {
+  if (r.passed) {
+    r.verdict = Verdict::pass;
+    return;
+  }
+  r.verdict = Verdict::fail;
+  const Method m = r.params.method;
+  if (m == Method::analytic) return;  // no steps to run out of between walls
+  const double decided = static_cast<double>(std::max<size_t>(r.aov.decided(), 1));
+  const double stuck_pixels =
+      static_cast<double>(r.aov.failures[static_cast<size_t>(Failure::stuck)]);
+  const double stuck = stuck_pixels / decided;
+  const double stuck_percent =
+      100.0 * stuck_pixels / static_cast<double>(std::max<size_t>(r.aov.pixels, 1));
+  for (const Check& c : r.checks) {
+    if (c.passed) continue;
+    const bool explained =
+        c.name == "failures.stuck" || c.name == "steps.ks" || c.name == "steps.mean_ratio" ||
+        ((c.name == "hit_rate" || c.name == "crossings_rate") && c.value + stuck >= c.limit) ||
+        ((c.name == "image.failpercent" || c.name == "image.perceptual_failpercent") &&
+         c.value - stuck_percent <= c.limit);
+    if (!explained) return;
+  }
+  if (stuck == 0.0 && !(r.params.offset <= r.params.eps)) return;
+  r.verdict = Verdict::limit;
+  std::ostringstream s;
+  s << to_string(m) << ": " << percent(stuck)
+    << " of the decided pixels ran out of steps (max_steps " << r.params.max_steps << ")";
+  if (r.params.offset <= r.params.eps)
+    s << ", offset " << r.params.offset << " <= eps " << r.params.eps
+      << " (rays cross each gluing back and forth)";
+  s << "; this method cannot render this scene at these parameters";
+  r.limit = s.str();
+}
+
 }  // namespace
+
+const char* to_string(Verdict v) {
+  switch (v) {
+    case Verdict::pass:
+      return "pass";
+    case Verdict::limit:
+      return "limit";
+    case Verdict::fail:
+      return "fail";
+  }
+  return "?";
+}
 
 std::vector<std::string> CaseResult::failed_checks() const {
   std::vector<std::string> lines;
@@ -208,6 +269,7 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   add_check(r, "traces.error", trace_error / scene.scale, t.trace_error, false);
   if (static_cast<int>(r.traces.size()) < t.probe_rays)
     r.warnings.push_back("only " + std::to_string(r.traces.size()) + " generic probe rays found");
+  judge(r);
   return r;
 }
 
@@ -257,6 +319,8 @@ json to_json(const CaseResult& r) {
       {"max_distance", r.params.max_distance},
       {"size", std::to_string(r.width) + "x" + std::to_string(r.height)},
       {"passed", r.passed},
+      {"verdict", to_string(r.verdict)},
+      {"limit", r.limit},
       {"seconds", r.seconds},
       {"delta", r.delta},
       {"pixels", r.aov.pixels},

@@ -27,6 +27,12 @@ struct Check {
   bool passed = true;
 };
 
+// A case's verdict (issue 22): it passes its thresholds; it fails them only through a
+// documented failure mode of its method (rays out of max_steps, offset <= eps), by no more than
+// that mode accounts for: a `limit` of the method, never a pass; or it fails.
+enum class Verdict { pass, limit, fail };
+const char* to_string(Verdict v);
+
 struct CaseResult {
   std::string backend, scene;
   MarchParams params;
@@ -41,7 +47,9 @@ struct CaseResult {
   FailureCounts trace_failures{};
   std::vector<Check> checks;
   std::vector<std::string> warnings;
-  bool passed = true;
+  bool passed = true;  // every check within its threshold
+  Verdict verdict = Verdict::pass;
+  std::string limit;     // for Verdict::limit: the failure mode and its measured size
   double seconds = 0.0;  // the backend's frame
   // The checks that failed, one line each.
   std::vector<std::string> failed_checks() const;

@@ -273,7 +273,7 @@ def failure_section(cases):
     totals = {}
     for c in cases:
         key = (c["backend"], c["method"])
-        t = totals.setdefault(key, {f: 0 for f in FAILURES} | {"cases": 0, "failed": 0, "errors": 0})
+        t = totals.setdefault(key, {f: 0 for f in FAILURES} | {"cases": 0, "failed": 0, "limits": 0, "errors": 0})
         t["cases"] += 1
         if "error" in c:
             t["errors"] += 1
@@ -281,21 +281,36 @@ def failure_section(cases):
         a = c.get("accuracy")
         if not a:
             continue
-        t["failed"] += not a["passed"]
+        verdict = a.get("verdict", "pass" if a["passed"] else "fail")
+        t["failed"] += verdict == "fail"
+        t["limits"] += verdict == "limit"
         for f in FAILURES:
             t[f] += a["failures"].get(f, 0)
     for (b, m), t in sorted(totals.items()):
-        rows.append([b, m, f'{t["cases"] - t["failed"] - t["errors"]}/{t["cases"]}'] +
+        rows.append([b, m, f'{t["cases"] - t["failed"] - t["limits"] - t["errors"]}/{t["cases"]}',
+                     td(t["limits"], "bad" if t["limits"] else "")] +
                     [td(t[f], "bad" if t[f] else "") for f in FAILURES])
     out = ["<h2 id=failures>Failures</h2><p>Rays of each failure class over the gallery (decided pixels of the "
            "conformance frames and diverging probe rays), per backend and method, and each case that failed "
            "a threshold, with the checks it failed.</p>",
-           table(["backend", "method", "cases passed"] + FAILURES, rows)]
-    failed = [c for c in cases if "error" in c or not c.get("accuracy", {}).get("passed", True)]
+           table(["backend", "method", "cases passed", "at the method's limit"] + FAILURES, rows)]
+
+    def verdict(c):
+        a = c.get("accuracy", {})
+        return a.get("verdict", "pass" if a.get("passed", True) else "fail")
+    failed = [c for c in cases if "error" in c or verdict(c) == "fail"]
+    limits = [c for c in cases if "error" not in c and verdict(c) == "limit"]
+    passed = len(cases) - len(failed) - len(limits)
+    out.append(f"<p>{passed} cases pass, {len(limits)} are at their method's limit (they fail the "
+               "thresholds only through a documented failure mode of the method, such as rays running out "
+               f"of max_steps: never counted as a pass), {len(failed)} fail.</p>")
     if failed:
         out.append(table(["case", "failed checks"], [
             [c["name"], c.get("error") or "; ".join(c["accuracy"]["failed_checks"])] for c in failed]))
-    else:
+    if limits:
+        out.append(table(["case at its method's limit", "why", "checks beyond the thresholds"], [
+            [c["name"], c["accuracy"]["limit"], "; ".join(c["accuracy"]["failed_checks"])] for c in limits]))
+    if not failed and not limits:
         out.append("<p class=good>Every case passed its thresholds.</p>")
     return "\n".join(out)
 

@@ -31,6 +31,8 @@ json accuracy_summary(const conformance::CaseResult& r) {
     if (!c.passed) failed.push_back(c.name);
   const double pixels = static_cast<double>(std::max<size_t>(r.aov.pixels, 1));
   return {{"passed", r.passed},
+          {"verdict", conformance::to_string(r.verdict)},
+          {"limit", r.limit},
           {"hit_mismatch", 1.0 - r.aov.hit_rate()},
           {"crossings_mismatch", 1.0 - r.aov.crossings_rate()},
           {"ambiguous", static_cast<double>(r.aov.ambiguous) / pixels},

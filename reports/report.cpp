@@ -90,7 +90,7 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
 
 json rank_backends(const json& matrix) {
   struct Tally {
-    int cases = 0, passed = 0, errors = 0;
+    int cases = 0, passed = 0, limits = 0, errors = 0;
     double log_rays = 0.0;
     int timed = 0;
     std::map<std::string, std::array<double, 4>> methods;  // cases, passed, log rays, timed
@@ -112,8 +112,14 @@ json rank_backends(const json& matrix) {
       ++t.errors;
       continue;
     }
-    const bool passed = !c.contains("accuracy") || c["accuracy"]["passed"].get<bool>();
+    // A case at its method's limit (issue 22) is no pass: counted apart.
+    const std::string verdict =
+        c.contains("accuracy")
+            ? c["accuracy"].value("verdict", c["accuracy"]["passed"].get<bool>() ? "pass" : "fail")
+            : "pass";
+    const bool passed = verdict == "pass";
     t.passed += passed;
+    t.limits += verdict == "limit";
     m[1] += passed;
     if (c.contains("counters") && c["counters"].value("rays_per_s", 0.0) > 0.0) {
       const double l = std::log(c["counters"]["rays_per_s"].get<double>());
@@ -149,6 +155,7 @@ json rank_backends(const json& matrix) {
     ranking.push_back({{"backend", b},
                        {"cases", t.cases},
                        {"passed", t.passed},
+                       {"limits", t.limits},
                        {"errors", t.errors},
                        {"pass_rate", t.cases ? static_cast<double>(t.passed) / t.cases : 0.0},
                        {"rays_per_s", t.timed ? std::exp(t.log_rays / t.timed) : 0.0},
@@ -236,12 +243,14 @@ std::string describe_selection(const json& results, const std::string& type) {
   }
   s += "ranking:\n";
   for (const json& b : results.at("ranking")) {
-    std::snprintf(
-        line, sizeof line, "  %zu. %-7s %8.3g Mrays/s  %d/%d cases conform%s",
-        b["rank"].get<size_t>(), b["backend"].get<std::string>().c_str(),
-        b["rays_per_s"].get<double>() / 1e6, b["passed"].get<int>(), b["cases"].get<int>(),
-        b["errors"].get<int>() ? (", " + std::to_string(b["errors"].get<int>()) + " errors").c_str()
-                               : "");
+    std::snprintf(line, sizeof line,
+                  "  %zu. %-7s %8.3g Mrays/s  %d/%d cases pass, %d at their method's limit%s",
+                  b["rank"].get<size_t>(), b["backend"].get<std::string>().c_str(),
+                  b["rays_per_s"].get<double>() / 1e6, b["passed"].get<int>(),
+                  b["cases"].get<int>(), b.value("limits", 0),
+                  b["errors"].get<int>()
+                      ? (", " + std::to_string(b["errors"].get<int>()) + " errors").c_str()
+                      : "");
     s += line;
     if (b.contains("device"))
       s += "  on " + b["device"]["name"].get<std::string>() +
@@ -280,7 +289,10 @@ json make_baseline(const json& results) {
     for (const Figure& f : kFigures)
       if (c.contains(f.source) && c[f.source].contains(f.name))
         figures[f.name] = c[f.source][f.name];
-    if (c.contains("accuracy")) figures["passed"] = c["accuracy"]["passed"];
+    if (c.contains("accuracy")) {
+      figures["passed"] = c["accuracy"]["passed"];
+      if (c["accuracy"].contains("verdict")) figures["verdict"] = c["accuracy"]["verdict"];
+    }
     cases[c["name"].get<std::string>()] = figures;
     if (c.contains("time_samples_ms")) timings[c["name"].get<std::string>()] = c["time_samples_ms"];
   }
@@ -351,6 +363,14 @@ json check_baseline(const json& baseline, const json& results) {
                                     {"figure", "passed"},
                                     {"was", true},
                                     {"now", false},
+                                    {"failed_checks", c["accuracy"]["failed_checks"]}});
+    // A case at its method's limit that now fails outright is a regression too.
+    if (figures.value("verdict", "") == "limit" && c.contains("accuracy") &&
+        c["accuracy"].value("verdict", "") == "fail")
+      out["regressions"].push_back({{"case", name},
+                                    {"figure", "verdict"},
+                                    {"was", "limit"},
+                                    {"now", "fail"},
                                     {"failed_checks", c["accuracy"]["failed_checks"]}});
     for (const Figure& f : kFigures) {
       if (!figures.contains(f.name) || !c.contains(f.source) || !c[f.source].contains(f.name))

@@ -271,6 +271,43 @@ TEST(Suite, TheScalarBackendPassesAndEachFlawIsCaughtByItsCheck) {
   const CaseResult leak = suite.run(Broken(Broken::Flaw::leaking_trace), scene, params, 64, 36);
   EXPECT_TRUE(failed(leak, "traces.diverged"));
   EXPECT_GT(leak.trace_failures[static_cast<size_t>(Failure::leak)], 0u);
+
+  // Every flaw fails, with sphere tracing too: none is a method's limit (issue 22), which only
+  // rays out of steps make.
+  for (const Method m : {Method::analytic, Method::sphere, Method::relaxed}) {
+    params.method = m;
+    EXPECT_EQ(suite.run(ScalarBackend(), scene, params, 64, 36).verdict, Verdict::pass);
+    for (const Broken::Flaw f :
+         {Broken::Flaw::extra_crossing, Broken::Flaw::phantom_object, Broken::Flaw::leaking_trace})
+      EXPECT_EQ(suite.run(Broken(f), scene, params, 64, 36).verdict, Verdict::fail)
+          << to_string(m) << " flaw " << static_cast<int>(f);
+  }
+}
+
+TEST(CliConform, SphereTracingAPrismIsAtItsLimitNotAPass) {
+  // Issue 22: in a translation prism every ray runs the whole max_distance, and sphere tracing
+  // runs out of steps on most of the pixels. That is the method's documented limit: `limit`, with
+  // the stuck share, exit 0; with --strict, exit 1. No threshold is bent for it.
+  const std::string dir = test::make_temp_dir();
+  const std::string json = dir + "/conform.json";
+  const std::string prism = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/l_shape_prism.json";
+  test::ProcessResult r = test::run_flatmarch(
+      {"conform", "--backend", "scalar", "--scene", prism, "--method", "sphere", "--json", json});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("limit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("of the decided pixels ran out of steps (max_steps 1024)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("1 cases: 0 pass, 1 at their method's limit, 0 failed"), std::string::npos)
+      << r.out;
+  const nlohmann::json c = nlohmann::json::parse(std::ifstream(json))["cases"][0];
+  EXPECT_EQ(c["verdict"], "limit");
+  EXPECT_FALSE(c["passed"].get<bool>());
+  EXPECT_GT(c["failures"]["stuck"].get<int>(), 0);
+  r = test::run_flatmarch({"conform", "--backend", "scalar", "--scene", prism, "--method", "sphere",
+                           "--json", json, "--strict"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("at their method's limit (--strict)"), std::string::npos) << r.err;
 }
 
 TEST(CliConform, PrintsATableWritesJsonAndExitsByTheVerdict) {
@@ -281,7 +318,9 @@ TEST(CliConform, PrintsATableWritesJsonAndExitsByTheVerdict) {
       {"conform", "--backend", "scalar", "--scene", torus, "--method", "analytic", "--json", json});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("scalar   torus"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("1 cases, 1 passed, 0 failed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 cases: 1 pass, 0 at their method's limit, 0 failed"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(json))["cases"][0]["verdict"], "pass");
   std::ifstream in(json);
   const nlohmann::json doc = nlohmann::json::parse(in);
   ASSERT_EQ(doc["cases"].size(), 1u);

@@ -242,6 +242,36 @@ TEST(Gate, DeterministicFiguresAreHeldToTheirTolerance) {
   EXPECT_TRUE(check["timing_warnings"].empty());  // three repetitions cannot be significant
 }
 
+TEST(Gate, ACaseAtItsMethodsLimitIsNoPassAndFailingOutrightRegresses) {
+  // Issue 22: a case at its method's limit counts apart from the passes in the ranking, and the
+  // gate flags it when it turns into a failure.
+  const auto with_verdict = [](json c, const char* verdict) {
+    c["accuracy"]["verdict"] = verdict;
+    return c;
+  };
+  json before = {
+      {"fingerprint", {{"cpu", {{"model", "t"}}}}},
+      {"options", json::object()},
+      {"matrix",
+       {{"cases",
+         json::array({with_verdict(matrix_case("s", "sphere", "x", 1e6, false, 10), "limit"),
+                      matrix_case("s", "analytic", "x", 1e6, true, 3)})}}}};
+  const json ranking = rank_backends(before["matrix"]);
+  ASSERT_EQ(ranking.size(), 1u);
+  EXPECT_EQ(ranking[0]["passed"], 1);
+  EXPECT_EQ(ranking[0]["limits"], 1);
+  EXPECT_EQ(ranking[0]["best_method"], "analytic");
+  const json baseline = make_baseline(before);
+  EXPECT_EQ(baseline["cases"]["s/sphere/x/32x18"]["verdict"], "limit");
+  json after = before;
+  after["matrix"]["cases"][0] =
+      with_verdict(matrix_case("s", "sphere", "x", 1e6, false, 10), "fail");
+  const json check = check_baseline(baseline, after);
+  ASSERT_EQ(check["regressions"].size(), 1u) << check.dump();
+  EXPECT_EQ(check["regressions"][0]["figure"], "verdict");
+  EXPECT_TRUE(check_baseline(baseline, before)["regressions"].empty());
+}
+
 TEST(Gate, SlowerTimingsWarnOnlyWhenSignificant) {
   json before = {
       {"fingerprint", {{"cpu", {{"model", "a"}}}}},
