@@ -102,13 +102,18 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
     const std::vector<Vec2> far = polygon.far_points(kFarRadius);
     std::vector<std::pair<Vec2, Vec2>> chain;
     for (size_t k = 0; k + 1 < far.size(); ++k) chain.push_back({far[k], far[k + 1]});
-    const auto far_link = [&](Vec2 a, Vec2 b) {
+    // An edge's segment from a to b and its line, of outward unit normal `normal`.
+    const auto record = [&](Vec2 a, Vec2 b, Vec2 normal) {
       typename Tables<real>::EdgeRecord r{};
-      const Vec2 normal = -glm::normalize(perp(b - a));  // outward: the room lies on the left
       r.segment = vec4(real(a.x), real(a.y), real(b.x), real(b.y));
       r.line = vec4(real(normal.x), real(normal.y), real(glm::dot(normal, a)),
                     real(1.0 / glm::dot(b - a, b - a)));
-      r.link.x = kEdgeWall;  // never reached: nothing to cross, no wall feature
+      return r;
+    };
+    const auto far_link = [&](Vec2 a, Vec2 b) {
+      // Outward: the room lies on the left. Never reached: nothing to cross, no wall feature.
+      auto r = record(a, b, -glm::normalize(perp(b - a)));
+      r.link.x = kEdgeWall;
       return r;
     };
     size_t next_link = 0;
@@ -122,10 +127,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
       Vec2 a = polygon.vertex(i), b = polygon.vertex(i + 1);
       if (edge.shape == EdgeShape::ray_out) a = edge.start, b = far.front();
       if (edge.shape == EdgeShape::ray_in) a = edge.start, b = far.back();
-      typename Tables<real>::EdgeRecord r{};
-      r.segment = vec4(real(a.x), real(a.y), real(b.x), real(b.y));
-      r.line = vec4(real(edge.normal.x), real(edge.normal.y), real(glm::dot(edge.normal, a)),
-                    real(1.0 / glm::dot(b - a, b - a)));
+      auto r = record(a, b, edge.normal);
       r.link.x = edge.kind == EdgeKind::glued    ? kEdgeGlued
                  : edge.kind == EdgeKind::mirror ? kEdgeMirror
                                                  : kEdgeWall;

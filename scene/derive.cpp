@@ -25,6 +25,12 @@ bool near(const Mat2& m, const Mat2& n, double tol) {
   return true;
 }
 
+// The reflection taking unit vector u to unit vector v (in the line between them).
+Mat2 reflection_between(Vec2 u, Vec2 v) {
+  const Vec2 w = glm::length(u + v) > 1e-6 ? glm::normalize(u + v) : perp(u);
+  return 2.0 * glm::outerProduct(w, w) - Mat2(1.0);
+}
+
 // The rotation by the angle from unit vector u to unit vector v.
 Mat2 rotation_between(Vec2 u, Vec2 v) {
   const double c = glm::dot(u, v), s = cross(u, v);
@@ -181,9 +187,7 @@ GluingMapResult derive_gluing_map(const Scene& scene, EdgeRef a, EdgeRef b, Glui
                   "a reflection glues two rays running the same way; " + name(a) + " runs " +
                       (ea.shape == EdgeShape::ray_out ? "out to" : "in from") + " infinity and " +
                       name(b) + " the other way (drop \"map\" for an isometry)"};
-        const Vec2 u = ea.along, v = eb.along;
-        const Vec2 w = glm::length(u + v) > 1e-6 ? glm::normalize(u + v) : perp(u);
-        r.g.linear = 2.0 * glm::outerProduct(w, w) - Mat2(1.0);
+        r.g.linear = reflection_between(ea.along, eb.along);
         break;
       }
     }
@@ -212,8 +216,7 @@ GluingMapResult derive_gluing_map(const Scene& scene, EdgeRef a, EdgeRef b, Glui
     case GluingMap::reflection: {
       if (!same_length) return {{}, lengths_differ()};
       const Vec2 u = (B - A) / la, v = (D - C) / lb;
-      const Vec2 w = glm::length(u + v) > 1e-6 ? glm::normalize(u + v) : perp(u);
-      r.g.linear = 2.0 * glm::outerProduct(w, w) - Mat2(1.0);
+      r.g.linear = reflection_between(u, v);
       r.g.translation = C - r.g.linear * A;
       return r;
     }
