@@ -9,6 +9,7 @@
 
 #include "backends/oracle/intersect.hpp"
 #include "kernels/camera.hpp"
+#include "kernels/compile.hpp"
 
 namespace flatmarch::conformance {
 
@@ -17,6 +18,14 @@ namespace {
 // The oracle follows rays much further than a kernel's max_steps would let it (one of its steps
 // is a whole room), bounded still.
 constexpr int kTruthMaxSteps = 100000;
+
+// The largest stretch of a linear map: its largest singular value.
+double stretch(const Mat2& m) {
+  const Mat2 mm = glm::transpose(m) * m;
+  const double half = 0.5 * (mm[0][0] + mm[1][1]);
+  const double det = mm[0][0] * mm[1][1] - mm[0][1] * mm[1][0];
+  return std::sqrt(half + std::sqrt(std::max(0.0, half * half - det)));
+}
 
 double unit_roundoff(Precision p) {
   return p == Precision::f32 ? 0x1p-24 : 0x1p-53;
@@ -96,6 +105,29 @@ Approach approach(const Scene& scene, int p, int index, Vec3 o, Vec3 d, double l
   return best;
 }
 
+// How far from a solid, in units of eps, its distance function (kernels/maths.glsl solid_sdf)
+// may still read eps. An edge where faces with normals at an angle phi meet is a max() of their
+// distances, which reads eps up to eps / cos(phi / 2) from the edge (1.5 times that where three
+// faces meet): a box's or cylinder's right-angled edges and corners sqrt(3); at the rim of a
+// hollow cube's hole a face meets the sphere at cos phi = -size / hole (2.9 eps for the default
+// hole of 1.3 size).
+double sdf_reach(const Scene& scene, int index) {
+  if (index >= static_cast<int>(scene.objects.size())) return std::sqrt(2.0);  // a marker
+  const Object& object = scene.objects[static_cast<size_t>(index)];
+  switch (object.type) {
+    case ObjectType::sphere:
+      return 1.0;
+    case ObjectType::box:
+    case ObjectType::cylinder:
+      return std::sqrt(3.0);
+    case ObjectType::hollow_cube: {
+      const double cosine = std::min(object.size / object.hole, 0.99);
+      return std::max(std::sqrt(3.0), 1.5 * std::sqrt(2.0 / (1.0 - cosine)));
+    }
+  }
+  return std::sqrt(3.0);
+}
+
 uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last, const RayEnd& end,
                           double delta, double eps, double crease) {
   const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
@@ -137,8 +169,9 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
     const bool exact = last && end.hit == index;
     // A shifted line meets a solid where the surface has moved away: further on where the ray
     // hits it, within the room (and delta) where it does not.
-    // Every method stops within eps of a solid: a line passing that close counts as a hit.
-    const double shifted = delta + eps;
+    // Every method stops where the solid's distance function falls below eps: a line passing
+    // that close counts as a hit. Near an edge of a solid that is farther than eps (sdf_reach).
+    const double shifted = delta + eps * sdf_reach(scene, index);
     const double limit = length + shifted + (exact ? scene.scale : 0.0);
     // A solid whose bounding volume the line clears by more than that cannot be grazed.
     const Approach near = approach(scene, seg.polygon, index, seg.from, d, length);
@@ -160,11 +193,16 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
         shifts.push_back(std::min(f * 1.1 * shifted, gap) * near.towards / gap);
       if (gap <= 1.1 * shifted) shifts.push_back(near.towards);
     }
-    for (const Vec3& shift : shifts)
-      if (meet(scene, seg.polygon, index, seg.from + shift, d, limit).has_value() != exact) {
+    // Where the ray hits, a shifted line that hits much nearer or farther (a hollow cube's face
+    // in front of its hole) leaves t to chance, as a miss would the hit.
+    const double jump = 0.01 * scene.scale;
+    for (const Vec3& shift : shifts) {
+      const auto hit = meet(scene, seg.polygon, index, seg.from + shift, d, limit);
+      if (hit.has_value() != exact || (exact && std::abs(hit->t - length) > jump)) {
         bits |= kSilhouette;
         break;
       }
+    }
     // At an edge of the solid the normal, and so the colour, jumps: a hit within the kernel's
     // normal step of one is a crease.
     if (!exact || (bits & kSilhouette)) continue;
@@ -201,52 +239,112 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
   const OracleResult r = oracle_trace(scene, ray, exact, {.record_path = true});
   RayTruth truth{r.end, 0};
   if (r.end.hit == kHitVertex) truth.ambiguity |= kNearVertex;
-  const double crease = 1.5 * std::cbrt(unit_roundoff(params.precision)) * scene.scale;
+  // The kernel's normal is a central difference on a tetrahedron reaching sqrt(3) h from the
+  // point: within that of an edge of a solid it mixes both sides' normals (doubled: the point
+  // itself lies up to eps off the surface, which shifted lines cover).
+  const double crease = 2.0 * std::sqrt(3.0) *
+                        (params.precision == Precision::f32 ? kernel::normal_step<float>(scene)
+                                                            : kernel::normal_step<double>(scene));
   const double on = 1e-9 * scene.scale;
-  // At a crossing the kernel places its point `offset` inside the new room, from wherever within
-  // eps of the edge it stopped: the ray moves (eps + offset) sin(angle) sideways, the angle
-  // between the ray and the edge's normal. The drifts add up, as they may in the worst case.
-  // The analytic method crosses at the exit point it computed, with no push: only rounding.
+  // At a crossing the kernel maps its point, which stopped s in [0, eps] short of the edge, into
+  // the new room and places it `offset` inside the edge it is now behind: the point moves
+  // (s + offset) along that edge's inward normal n, the ray sideways by (s + offset) times the
+  // part of n across the new direction. The shifts of successive crossings are vectors: they add
+  // with their signs (in an L-shaped room a ray meets edges on both of its sides, and their shifts
+  // cancel in part) and turn with the gluings that carry the ray on. So this follows the kernel's
+  // expected sideways shift, s = eps / 2 at each crossing, carried through every gluing's linear
+  // part and every mirror, and around it a spread that adds up what cannot cancel: eps / 2 times
+  // each push's sideways part, rounding (16 u scale a crossing) and the turn of a rounded
+  // direction (4 u a unit of length). The analytic method crosses at the exit point it computed,
+  // with no push: only rounding.
   const double u = unit_roundoff(params.precision);
   const double push = params.method == Method::analytic ? 0.0 : params.eps + params.offset;
-  double drift = delta;
+  Vec3 shift(0.0);  // the expected sideways shift, in the current room's coordinates
+  // What may lie around it, whatever the signs, kept in the camera's room's coordinates and
+  // carried into the current room's by `carried` (the product of the linear parts of the gluings
+  // and mirrors crossed): a stretch and its inverse, crossed in turn, then cancel as they do.
+  double spread0 = 0.0;
+  Mat2 carried(1.0);
+  const auto spread = [&] { return stretch(carried) * spread0; };
+  const auto add_spread = [&](double x) { spread0 += x * stretch(glm::inverse(carried)); };
   int crossings = 0;
   for (size_t k = 0; k < r.path.size(); ++k) {
     const PathSegment& seg = r.path[k];
     const bool last = k + 1 == r.path.size();
+    const Vec3 step = seg.to - seg.from;
+    const double length = glm::length(step);
+    const Vec3 d = length > 0.0 ? step / length : Vec3(0.0);
+    const double drift = delta + glm::length(shift - glm::dot(shift, d) * d) + spread();
     truth.ambiguity |= segment_ambiguity(scene, seg, last, r.end, drift, params.eps, crease);
-    // The direction is rounded too: the ray turns by about 2^-24, so drifts that much a unit.
-    drift += 4.0 * u * glm::length(seg.to - seg.from);
+    add_spread(4.0 * u * length);
     if (last || !scene.in_band(seg.from.z)) continue;
     const Polygon& polygon = scene.polygons[static_cast<size_t>(seg.polygon)];
-    for (int e = 0; e < polygon.size(); ++e)
-      if (polygon.edges[static_cast<size_t>(e)].distance(Vec2(seg.to)) < on) {
-        const Vec3 step = seg.to - seg.from;
-        const double length = glm::length(step);
-        const Vec3 n(polygon.edges[static_cast<size_t>(e)].normal, 0.0);
-        const double along = length > 0.0 ? glm::dot(n, step) / length : 0.0;
-        drift += push * std::sqrt(std::max(0.0, 1.0 - along * along)) + 16.0 * u * scene.scale;
-        if (push > 0.0) truth.t_slack += params.eps / std::max(std::abs(along), 1e-3) + push;
-        ++crossings;
-        break;
+    for (int e = 0; e < polygon.size(); ++e) {
+      const Edge& edge = polygon.edges[static_cast<size_t>(e)];
+      if (edge.distance(Vec2(seg.to)) >= on) continue;
+      // The shift so far, carried into the next room: a vector under the gluing's linear part,
+      // reflected by a mirror.
+      Mat2 m(1.0);
+      if (edge.kind == EdgeKind::mirror)
+        m -= 2.0 * glm::outerProduct(edge.normal, edge.normal);
+      else if (edge.kind == EdgeKind::glued)
+        m = edge.map.linear;
+      const Vec2 v = m * Vec2(shift);
+      shift = Vec3(v, shift.z);
+      carried = m * carried;
+      const double scaled = stretch(m);
+      const double along = glm::dot(Vec3(edge.normal, 0.0), d);
+      if (push > 0.0) {
+        // The push, along the inward normal of the edge the ray is now behind, across the
+        // direction the ray goes on in.
+        const PathSegment& next = r.path[k + 1];
+        const Vec3 next_step = next.to - next.from;
+        const double next_length = glm::length(next_step);
+        const Vec3 dn = next_length > 0.0 ? next_step / next_length : d;
+        const Polygon& behind = scene.polygons[static_cast<size_t>(next.polygon)];
+        Vec2 n(0.0);
+        for (int b = 0; b < behind.size(); ++b) {
+          const Edge& candidate = behind.edges[static_cast<size_t>(b)];
+          if (candidate.distance(Vec2(next.from)) < on) {
+            n = -candidate.normal;  // inward
+            break;
+          }
+        }
+        const Vec3 n3(n, 0.0);
+        const Vec3 across = n3 - glm::dot(n3, dn) * dn;
+        const double s = 0.5 * params.eps * scaled;
+        shift += (params.offset + s) * across;
+        add_spread(s * glm::length(across));
+        truth.t_slack += params.eps / std::max(std::abs(along), 1e-3) + push;
       }
+      add_spread(16.0 * u * scene.scale);
+      ++crossings;
+      break;
+    }
   }
+  const double drift = delta + glm::length(shift) + spread();
   if (!r.path.empty() && (r.end.hit >= 0 || (r.end.hit == kHitWall && push > 0.0))) {
     const Vec3 step = r.path.back().to - r.path.back().from;
     const double length = glm::length(step);
     const double cosine = length > 0.0 ? std::abs(glm::dot(step, r.end.normal)) / length : 1.0;
     truth.t_slack += params.eps / std::max(cosine, 1e-3);
   }
-  // t is summed step by step: in float32 it drifts by about 2^-24 of the distance a step. A ray
-  // whose end lies that close to max_distance, on either side, may end either way.
+  // t is summed step by step: in float32 it drifts by about 2^-24 of the distance a step. And
+  // each crossing's stop short of the edge and push shorten or lengthen it (t_slack). A ray whose
+  // end, or whose last crossing before max_distance, lies that close to max_distance, on either
+  // side, may end either way: with another hit, or after another number of crossings.
   // A solid counts as hit within eps of it, sooner by eps / cos(incidence): 10 eps covers
   // incidences up to 84 degrees.
-  const double slack = drift + push * static_cast<double>(crossings) +
-                       64.0 * u * params.max_distance + 10.0 * params.eps;
+  const double slack = drift + truth.t_slack + 64.0 * u * params.max_distance + 10.0 * params.eps;
   if (r.end.hit == kHitMaxDistance) {
-    exact.max_distance = params.max_distance + slack;
-    if (oracle_trace(scene, ray, exact).end.hit != kHitMaxDistance)
-      truth.ambiguity |= kNearDistance;
+    for (const double reach : {params.max_distance - slack, params.max_distance + slack}) {
+      exact.max_distance = std::max(reach, 0.0);
+      const RayEnd e = oracle_trace(scene, ray, exact).end;
+      if (e.hit != kHitMaxDistance || e.crossings != r.end.crossings) {
+        truth.ambiguity |= kNearDistance;
+        break;
+      }
+    }
   } else if (r.end.t > params.max_distance - slack) {
     truth.ambiguity |= kNearDistance;
   }
@@ -254,8 +352,8 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
 }
 
 size_t FrameTruth::ambiguous() const {
-  return static_cast<size_t>(
-      std::count_if(ambiguity.begin(), ambiguity.end(), [](uint8_t a) { return a != 0; }));
+  return static_cast<size_t>(std::count_if(ambiguity.begin(), ambiguity.end(),
+                                           [](uint8_t a) { return (a & kPathAmbiguity) != 0; }));
 }
 
 FrameTruth frame_truth(const Scene& scene, const Camera& camera, int width, int height,

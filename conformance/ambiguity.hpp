@@ -46,13 +46,17 @@ enum Ambiguity : uint8_t {
   kCrease = 32         // hits a solid within the kernel's normal step of an edge of it
 };
 inline constexpr int kAmbiguityReasons = 6;
+// The bits that leave a ray's path undecided (its hit, crossings and t); a crease alone puts only
+// its colour in doubt: the path is decided and judged.
+inline constexpr uint8_t kPathAmbiguity =
+    kNearVertex | kNearEdge | kBandEdge | kSilhouette | kNearDistance;
 
 // delta for these parameters in this scene (above).
 double ambiguity_delta(const Scene& scene, const MarchParams& params);
 
 struct RayTruth {
   RayEnd end;
-  uint8_t ambiguity = 0;  // Ambiguity bits; 0: the ray is decided
+  uint8_t ambiguity = 0;  // Ambiguity bits; none of kPathAmbiguity: the ray's path is decided
   // How much shorter (or longer) the kernel's path length t may come out, rounding aside: at
   // each crossing sphere tracing stops up to eps / cos(incidence) short of the edge and the push
   // moves the point up to eps + offset along the ray; a solid (every method) or a wall (sphere,
@@ -70,7 +74,7 @@ struct FrameTruth {
   std::vector<float> t_slack;      // a pixel's RayTruth::t_slack
   double delta = 0.0;
   double unit_roundoff = 0.0;  // of the precision the frame is compared in
-  size_t ambiguous() const;
+  size_t ambiguous() const;    // pixels whose path is undecided
 };
 
 FrameTruth frame_truth(const Scene& scene, const Camera& camera, int width, int height,

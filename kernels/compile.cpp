@@ -188,7 +188,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
   // the larger step 4.8% of an L-shape frame at a 20 degree field of view (the pixels of the
   // hollow cubes) differed from the oracle's exact normals by more than 0.05, with this one 0.4%.
   // Rounding stays far below that: ulp x scale / step is 2e-4 in float32.
-  k.normal_step = real(std::cbrt(kUlp) * scene.scale / 16.0);
+  k.normal_step = real(normal_step<real>(scene));
   set_look<real>(scene.look, k);
   k.period_tint = vec4(period_tint(scene));
   return t;

@@ -2,6 +2,8 @@
 // unchanged (kernels/tables.glsl), holding only what the scene uses.
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "kernels/kernel.hpp"
@@ -34,6 +36,13 @@ inline constexpr double kReach = 0x1p30;
 // an unbounded scene would run beyond kReach within max_distance. compile_scene checks the
 // scene's own camera; a caller that moves the camera checks its own.
 void check_reach(const Scene& scene, double max_distance, Vec2 camera);
+
+// The step of the central differences that give a solid's normal in `real` (compile.cpp says
+// why this one); the ambiguity mask's creases are as wide as the stencil reaches.
+template <typename real>
+double normal_step(const Scene& scene) {
+  return std::cbrt(static_cast<double>(std::numeric_limits<real>::epsilon())) * scene.scale / 16.0;
+}
 
 // `march.method` must be one the kernel runs (sphere, relaxed, analytic); throws as check_reach.
 template <typename real>
