@@ -7,6 +7,7 @@
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "conformance/suite.hpp"
+#include "output/image_io.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::cli {
@@ -54,7 +55,7 @@ void add_conform(CLI::App& app) {
   struct Options {
     std::vector<std::string> backends, scenes, methods;
     std::vector<std::string> galleries = {"scenes", "conformance/scenes"};
-    std::string size = "160x90", json = "conform.json", thresholds;
+    std::string size = "160x90", json = "conform.json", thresholds, error_images;
     std::string precision = "f32";
     MarchParams params;
     BackendOptions backend_options;
@@ -77,6 +78,9 @@ void add_conform(CLI::App& app) {
   cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
   cmd->add_option("--thresholds", o->thresholds,
                   "Thresholds file (default: conformance/thresholds.json as built in)");
+  cmd->add_option("--error-images", o->error_images,
+                  "Write each case's error image into this folder, BACKEND-SCENE-METHOD.png: " +
+                      conformance::error_legend());
   add_march_param_options(*cmd, o->params);
   cmd->add_option("--precision", o->precision, "f32 or f64 (backends without f64 are skipped)")
       ->capture_default_str();
@@ -109,6 +113,14 @@ void add_conform(CLI::App& app) {
     }
 
     conformance::Suite suite(thresholds);
+    if (!o->error_images.empty()) {
+      std::error_code error;
+      fs::create_directories(o->error_images, error);
+      if (error)
+        throw UsageError("--error-images: cannot create " + o->error_images + ": " +
+                         error.message());
+      suite.keep_pixel_classes(true);
+    }
     nlohmann::json out = {{"cases", nlohmann::json::array()}, {"skipped", nlohmann::json::array()}};
     int cases = 0, failed = 0, limits = 0;
     if (!o->quiet)
@@ -137,6 +149,14 @@ void add_conform(CLI::App& app) {
           failed += r.verdict == conformance::Verdict::fail;
           limits += r.verdict == conformance::Verdict::limit;
           out["cases"].push_back(conformance::to_json(r));
+          if (!o->error_images.empty()) {
+            const fs::path file =
+                fs::path(o->error_images) / (name + "-" + scene.name + "-" + to_string(m) + ".png");
+            write_png(
+                conformance::error_image(r.pixel_classes, suite.truth_frame(scene, params, w, h)),
+                file);
+            out["cases"].back()["error_image"] = file.string();
+          }
           if (o->quiet) continue;
           int diverged = 0;
           for (const auto& t : r.traces) diverged += t.failure.has_value();

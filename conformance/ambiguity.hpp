@@ -1,31 +1,36 @@
 // The oracle's truth for a frame, with the pixels that finite precision cannot decide.
 //
 // A marching kernel does not follow the exact ray. Sphere tracing (and its relaxed form) stops
-// within `eps` of an edge and places the point `offset` inside the destination room, which moves
-// the ray (eps + offset) sin(a) sideways, a the angle between the ray and the edge's normal; the
-// analytic method crosses at the exit point it computed, with no push. Both round every position
-// to about u = 2^-24 (f32) or 2^-53 (f64) of the scene's scale, and their direction turns by about
-// u, so the ray drifts a few u a unit of length. So the kernel's ray may lie up to
+// s in [0, eps] short of an edge, maps the point into the next room and places it `offset` inside
+// the edge it is now behind: the ray moves (s + offset) along that edge's inward normal, sideways
+// by the part of it across the new direction. The analytic method crosses at the exit point it
+// computed, with no push. Both round every position to about u = 2^-24 (f32) or 2^-53 (f64) of
+// the scene's scale, and their direction turns by about u, so the ray drifts a few u a unit of
+// length. Per ray, along its exact path (ray_truth), the kernel's ray lies within
 //
-//     delta_n = delta + sum over the crossings so far of (push sin(a) + 16 u scale)
-//               + 4 u (length so far)
-//     delta   = eps + offset + 16 u scale      (sphere, relaxed; push = eps + offset)
-//             = 32 u scale                     (analytic: rounding and its vertex tolerance;
-//                                               push = 0)
+//     delta_n = delta + |the expected shift across the ray| + spread
+//     delta   = eps + offset + 16 u scale      (sphere, relaxed)
+//             = 32 u scale                     (analytic: rounding and its vertex tolerance)
 //
-// from the exact one: the drifts add up, as they may in the worst case.
+// of the exact one: the expected shift adds each crossing's push, s = eps / 2, as a vector with
+// its sign, carried through each gluing's linear part and reflected by mirrors (in an L-shaped
+// room the pushes of edges on either side of the ray cancel in part); the spread adds, whatever
+// their signs, eps / 2 of each push, 16 u scale a crossing and 4 u a unit of length, and is
+// stretched and shrunk with the gluings' linear parts.
 //
 // A pixel whose exact path passes within delta_n of a vertex (a cone point or any corner), runs
 // within delta_n of an edge it does not cross, meets an edge within delta_n of the top or bottom
 // of the wall band (or leaves the band within delta_n of an edge), grazes an object's silhouette
-// (a line shifted delta_n + eps sideways, eps because every method stops that near a solid, meets
-// the object where the exact one does not, or the other way round), or ends near max_distance
-// (within delta_n plus the push's shortening of the path, t's rounding and 10 eps, as solids are
-// hit within eps of them, on either side) can go
-// either way; one that hits a solid near an edge of it, where the normal jumps (a line shifted by
-// the kernel's normal step meets the solid with a normal that differs on one side only), has a
-// colour that can go either way. Such pixels are reported apart instead of being counted as
-// failures, in the spirit of VK-GL-CTS's position-deviation compares.
+// (a line shifted delta_n + eps sideways, eps because every method stops where a solid's distance
+// reads eps, which near a solid's edge is up to a few eps away, meets the object where the exact
+// one does not, or the other way round, or meets it much nearer or farther), or ends, or makes its
+// last crossing, near max_distance (within delta_n plus the pushes' change of the path length,
+// t's rounding and 10 eps, on either side) can go either way: its path is undecided
+// (kPathAmbiguity). One that hits a solid near an edge of it, where the normal jumps (a line
+// shifted as far as the kernel's normal stencil reaches meets the solid with a normal that
+// differs on one side only: a crease), has a colour that can go either way; its path is decided.
+// Such pixels are reported apart instead of being counted as failures (creases only by the colour
+// checks), in the spirit of VK-GL-CTS's position-deviation compares.
 #pragma once
 
 #include <cstdint>

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "output/image_library.hpp"
@@ -111,6 +112,104 @@ ImageComparison compare_images(const Frame& got, const Frame& truth,
   return c;
 }
 
+namespace {
+
+// CIELAB of a linear sRGB colour (D65 white).
+std::array<double, 3> lab(const float* rgb) {
+  const auto c = [&](int k) { return std::clamp(static_cast<double>(rgb[k]), 0.0, 1.0); };
+  const double r = c(0), g = c(1), b = c(2);
+  const double x = (0.4124564 * r + 0.3575761 * g + 0.1804375 * b) / 0.95047;
+  const double y = 0.2126729 * r + 0.7151522 * g + 0.0721750 * b;
+  const double z = (0.0193339 * r + 0.1191920 * g + 0.9503041 * b) / 1.08883;
+  const auto f = [](double v) {
+    constexpr double d = 6.0 / 29.0;
+    return v > d * d * d ? std::cbrt(v) : v / (3.0 * d * d) + 4.0 / 29.0;
+  };
+  return {116.0 * f(y) - 16.0, 500.0 * (f(x) - f(y)), 200.0 * (f(y) - f(z))};
+}
+
+// The region a hit code belongs to: {region, object or marker index}; nothing for a ray that
+// ended without a surface (max_steps, vertex).
+std::optional<std::pair<Region, int>> region_of(int hit, int objects) {
+  if (hit >= objects) return std::pair{Region::marker, hit - objects};
+  if (hit >= 0) return std::pair{Region::object, hit};
+  if (hit == kHitWall) return std::pair{Region::walls, 0};
+  if (hit == kHitFloor) return std::pair{Region::floor, 0};
+  if (is_escape(hit)) return std::pair{Region::sky, 0};
+  return std::nullopt;
+}
+
+}  // namespace
+
+double delta_e(const float* a, const float* b) {
+  const auto p = lab(a), q = lab(b);
+  return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                   (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+std::string RegionColour::name() const {
+  switch (region) {
+    case Region::object:
+      return "object " + std::to_string(hit);
+    case Region::marker:
+      return "marker " + std::to_string(hit);
+    case Region::walls:
+      return "walls";
+    case Region::floor:
+      return "floor";
+    case Region::sky:
+      return "sky";
+  }
+  return "?";
+}
+
+std::vector<RegionColour> compare_regions(const Frame& got, const Frame& truth,
+                                          const std::vector<uint8_t>& mask,
+                                          const ColourThresholds& t, int objects,
+                                          std::vector<uint8_t>* failing) {
+  std::map<std::pair<Region, int>, RegionColour> regions;
+  if (failing) failing->assign(truth.hit.size(), 0);
+  for (int j = 0; j < truth.height; ++j)
+    for (int i = 0; i < truth.width; ++i) {
+      const size_t px = truth.pixel(i, j);
+      const int want = static_cast<int>(truth.hit[px]);
+      const auto key = region_of(want, objects);
+      if (!key || (px < mask.size() && mask[px]) || static_cast<int>(got.hit[px]) != want ||
+          got.crossings[px] != truth.crossings[px])
+        continue;
+      RegionColour& r = regions[*key];
+      r.region = key->first;
+      r.hit = key->second;
+      ++r.pixels;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const int x = i + di, y = j + dj;
+          if (x < 0 || y < 0 || x >= truth.width || y >= truth.height) continue;
+          const size_t q = truth.pixel(x, y);
+          if (region_of(static_cast<int>(truth.hit[q]), objects) != key) continue;
+          nearest = std::min(nearest, delta_e(&got.rgb[3 * px], &truth.rgb[3 * q]));
+        }
+      if (nearest > t.delta_e) {
+        ++r.failed;
+        if (failing) (*failing)[px] = 1;
+      }
+      if (nearest > r.worst) {
+        r.worst = nearest;
+        r.worst_x = i;
+        r.worst_y = j;
+      }
+    }
+  std::vector<RegionColour> out;
+  for (auto& [key, r] : regions) {
+    r.passed =
+        r.failed <= static_cast<size_t>(t.allowed) ||
+        100.0 * static_cast<double>(r.failed) <= t.failpercent * static_cast<double>(r.pixels);
+    out.push_back(r);
+  }
+  return out;
+}
+
 StepStats step_stats(const Channel& steps) {
   StepStats s;
   if (steps.empty()) return s;
@@ -159,12 +258,14 @@ AovComparison compare_aovs(const Frame& got, const FrameTruth& truth, double sca
   c.pixels = truth.frame.hit.size();
   for (size_t px = 0; px < c.pixels; ++px) {
     c.most_steps = std::max(c.most_steps, got.steps[px]);
-    if (const uint8_t bits = truth.ambiguity[px]) {
+    const uint8_t bits = truth.ambiguity[px];
+    for (size_t b = 0; b < c.ambiguity_reasons.size(); ++b)
+      c.ambiguity_reasons[b] += (bits >> b) & 1u;
+    if (bits & kPathAmbiguity) {
       ++c.ambiguous;
-      for (size_t b = 0; b < c.ambiguity_reasons.size(); ++b)
-        c.ambiguity_reasons[b] += (bits >> b) & 1u;
       continue;
     }
+    c.creases += bits != 0;
     const int hit = static_cast<int>(got.hit[px]), want = static_cast<int>(truth.frame.hit[px]);
     const int crossings = static_cast<int>(got.crossings[px]);
     const int want_crossings = static_cast<int>(truth.frame.crossings[px]);

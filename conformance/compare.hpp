@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -57,6 +58,42 @@ struct ImageComparison {
 ImageComparison compare_images(const Frame& got, const Frame& truth,
                                const std::vector<uint8_t>& mask, const ImageThresholds& t);
 
+// --- Colour per region (issue 22): over a whole frame a wrongly shaded object, a few percent of
+// the pixels, hides under the image thresholds; judged over its own pixels it cannot. A region is
+// an object or vertex marker (by its hit index), the walls, the floor or the sky (escape, miss,
+// max_distance). A pixel is compared where the mask decides it and the backend's ray ended as the
+// oracle's (same hit, same crossings: the others are failures of their own class). It fails when
+// its colour differs by more than `delta_e` (CIE 1976 Delta E in CIELAB, of the tone-mapped
+// linear colour, D65) from the oracle's at that pixel and at each of its 8 neighbours of the same
+// region: a colour that an edge, a rim or a crease moves by less than a pixel is not a wrong
+// shading, a wrong shading of a face is.
+struct ColourThresholds {
+  double delta_e = 6.0;      // a pixel's largest colour difference
+  double failpercent = 2.0;  // of a region's compared pixels, at most
+  int allowed = 2;           // failing pixels any region may have, whatever its size
+};
+
+enum class Region { object, marker, walls, floor, sky };
+struct RegionColour {
+  Region region = Region::object;
+  int hit = 0;         // the object's or the vertex marker's index
+  size_t pixels = 0;   // compared
+  size_t failed = 0;   // over delta_e from every neighbour
+  double worst = 0.0;  // the largest difference from the nearest neighbour's colour
+  int worst_x = 0, worst_y = 0;
+  bool passed = true;
+  std::string name() const;  // "object 0", "marker 1", "walls", "floor", "sky"
+};
+
+// CIE 1976 Delta E between two linear sRGB colours (clamped to [0, 1]).
+double delta_e(const float* a, const float* b);
+
+// The regions of `truth`, compared as above; `failing`, when given, gets 1 at each failing pixel.
+std::vector<RegionColour> compare_regions(const Frame& got, const Frame& truth,
+                                          const std::vector<uint8_t>& mask,
+                                          const ColourThresholds& t, int objects,
+                                          std::vector<uint8_t>* failing = nullptr);
+
 // --- Step counts: their distribution against a reference's.
 struct StepStats {
   double mean = 0.0, p50 = 0.0, p90 = 0.0, p99 = 0.0, max = 0.0;
@@ -68,9 +105,10 @@ double ks_statistic(const Channel& a, const Channel& b);
 
 // --- AOVs against the oracle's, on the pixels the ambiguity mask leaves decided.
 struct AovComparison {
-  size_t pixels = 0, ambiguous = 0;
-  size_t hit_equal = 0;        // decided pixels whose hit is the oracle's
-  size_t crossings_equal = 0;  // decided pixels whose crossings are the oracle's
+  size_t pixels = 0, ambiguous = 0;  // ambiguous: the path undecided (kPathAmbiguity)
+  size_t creases = 0;                // decided, but the colour in doubt (kCrease alone)
+  size_t hit_equal = 0;              // decided pixels whose hit is the oracle's
+  size_t crossings_equal = 0;        // decided pixels whose crossings are the oracle's
   // t on the decided pixels that end as the oracle's, at a surface or escaping: |t - t'| against
   // 1.25 times the truth's t_slack plus rounding, 64 u (t + scale) (steps + 1).
   size_t t_compared = 0, t_exceeded = 0;
@@ -78,7 +116,7 @@ struct AovComparison {
   FailureCounts failures{};                         // decided pixels, by class
   std::map<std::pair<int, int>, size_t> confusion;  // (oracle's hit, got) -> decided pixels
   std::array<size_t, kAmbiguityReasons>
-      ambiguity_reasons{};  // pixels with each Ambiguity bit, in bit order
+      ambiguity_reasons{};  // pixels with each Ambiguity bit, in bit order (creases too)
   float most_steps = 0.0f;
   size_t decided() const { return pixels - ambiguous; }
   double hit_rate() const;

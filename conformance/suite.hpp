@@ -4,6 +4,7 @@
 // reference) across the cases that share it.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -41,7 +42,8 @@ struct CaseResult {
   double delta = 0.0;  // the ambiguity mask's delta (ambiguity.hpp)
   AovComparison aov;
   ImageComparison image;
-  StepStats steps, reference_steps;  // reference: the scalar backend in float64
+  std::vector<RegionColour> regions;  // colour per object, marker, walls, floor, sky
+  StepStats steps, reference_steps;   // reference: the scalar backend in float64
   double steps_ks = 0.0;
   std::vector<TraceComparison> traces;
   FailureCounts trace_failures{};
@@ -51,9 +53,27 @@ struct CaseResult {
   Verdict verdict = Verdict::pass;
   std::string limit;     // for Verdict::limit: the failure mode and its measured size
   double seconds = 0.0;  // the backend's frame
+  // Why each pixel is off, row-major (PixelClass): filled when the suite keeps error images.
+  std::vector<uint8_t> pixel_classes;
   // The checks that failed, one line each.
   std::vector<std::string> failed_checks() const;
 };
+
+// What a pixel of a case's error image shows: agreement, the mask's doubt, a colour beyond the
+// region's tolerance, or the failure class (compare.hpp) of its ray, kPixelFailure + the class.
+enum PixelClass : uint8_t {
+  kPixelAgrees = 0,
+  kPixelAmbiguous = 1,
+  kPixelColour = 2,
+  kPixelFailure = 3
+};
+
+// The error image of a case from its pixel classes and the oracle's frame: the oracle's colour,
+// dimmed to grey, where the pixel agrees; dark blue where it is ambiguous; a loud colour per
+// reason elsewhere (error_legend()). Its hit channel holds the pixel's class.
+Frame error_image(const std::vector<uint8_t>& classes, const Frame& truth);
+// The colours of error_image, one line per reason: "magenta: stuck (...)".
+std::string error_legend();
 
 // Nearly horizontal rays from random points of random rooms (a fixed seed), kept when their exact
 // path up to `events` events keeps 1% of the scene's scale from every vertex and crosses every
@@ -73,6 +93,12 @@ class Suite {
   // over eps and offset then measures each point against one truth, and a large eps cannot
   // widen the mask over the pixels it gets wrong.
   void fix_mask(const MarchParams& mask) { mask_ = mask; }
+  // Keeps each case's pixel classes (CaseResult::pixel_classes) for an error image.
+  void keep_pixel_classes(bool keep) { keep_classes_ = keep; }
+  // The oracle's frame a case was judged against (run() computes it first).
+  const Frame& truth_frame(const Scene& scene, const MarchParams& params, int width, int height) {
+    return truth(scene, params, width, height).frame;
+  }
 
  private:
   const FrameTruth& truth(const Scene& scene, const MarchParams& params, int width, int height);
@@ -82,6 +108,7 @@ class Suite {
 
   nlohmann::json thresholds_;
   std::optional<MarchParams> mask_;
+  bool keep_classes_ = false;
   std::map<std::string, FrameTruth> truths_;
   std::map<std::string, Frame> references_;
   std::map<std::string, std::vector<std::pair<Ray, Trace>>> probes_;

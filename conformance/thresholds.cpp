@@ -52,6 +52,21 @@ void read_image(const json& j, ImageThresholds& t, const std::string& where) {
   }
 }
 
+void read_colour(const json& j, ColourThresholds& t, const std::string& where) {
+  if (!j.is_object()) fail(where, "expected an object");
+  for (const auto& [key, v] : j.items()) {
+    const std::string at = where + "/" + key;
+    if (key == "delta_e")
+      t.delta_e = number(v, at, 0, 1000);
+    else if (key == "failpercent")
+      t.failpercent = number(v, at, 0, 100);
+    else if (key == "allowed")
+      t.allowed = integer(v, at, 0, 1000000);
+    else
+      fail(at, "unknown key");
+  }
+}
+
 // Applies one set of thresholds (a patch already merged, or a part of one) to `t`.
 void read(const json& j, Thresholds& t, const std::string& where) {
   if (!j.is_object()) fail(where, "expected an object");
@@ -67,6 +82,8 @@ void read(const json& j, Thresholds& t, const std::string& where) {
       t.t_exceeded_max = number(v, at, 0, 1);
     else if (key == "image")
       read_image(v, t.image, at);
+    else if (key == "colour")
+      read_colour(v, t.colour, at);
     else if (key == "steps_ks_max")
       t.steps_ks_max = number(v, at, 0, 1);
     else if (key == "steps_mean_ratio_max")
@@ -109,7 +126,14 @@ void check(const json& doc, const std::string& file) {
       read(v, scratch, at);
     else if (key == "methods" || key == "backends") {
       if (!v.is_object()) fail(at, "expected an object");
-      for (const auto& [name, patch] : v.items()) read(patch, scratch, at + "/" + name);
+      for (const auto& [name, patch] : v.items()) {
+        if (!patch.is_object()) fail(at + "/" + name, "expected an object");
+        json p = patch;
+        if (p.contains("why") && !p["why"].is_string())
+          fail(at + "/" + name + "/why", "expected a string");
+        p.erase("why");
+        read(p, scratch, at + "/" + name);
+      }
     } else if (key == "exceptions") {
       if (!v.is_array()) fail(at, "expected an array");
       for (size_t k = 0; k < v.size(); ++k) {
@@ -166,10 +190,19 @@ Thresholds thresholds_for(const json& doc, const std::string& backend, Method me
                           const std::string& scene) {
   json merged = doc.value("defaults", json::object());
   const std::string m = to_string(method);
-  if (doc.contains("methods") && doc["methods"].contains(m)) merged.merge_patch(doc["methods"][m]);
-  if (doc.contains("backends") && doc["backends"].contains(backend))
-    merged.merge_patch(doc["backends"][backend]);
   std::string why;
+  // A method's or backend's layer, with its reason.
+  const auto layer = [&](const char* key, const std::string& name) {
+    if (!doc.contains(key) || !doc[key].contains(name)) return;
+    json patch = doc[key][name];
+    if (patch.contains("why")) {
+      why += (why.empty() ? "" : "; ") + name + ": " + patch["why"].get<std::string>();
+      patch.erase("why");
+    }
+    merged.merge_patch(patch);
+  };
+  layer("methods", m);
+  layer("backends", backend);
   for (const json& e : doc.value("exceptions", json::array()))
     if (names(e, "scenes", scene) && names(e, "methods", m) && names(e, "backends", backend)) {
       merged.merge_patch(e["set"]);
@@ -196,6 +229,10 @@ json to_json(const Thresholds& t) {
             {"warn", t.image.warn},
             {"warnpercent", t.image.warnpercent},
             {"perceptual_failpercent", t.image.perceptual_failpercent}}},
+          {"colour",
+           {{"delta_e", t.colour.delta_e},
+            {"failpercent", t.colour.failpercent},
+            {"allowed", t.colour.allowed}}},
           {"steps_ks_max", t.steps_ks_max},
           {"steps_mean_ratio_max", t.steps_mean_ratio_max},
           {"probe_rays", t.probe_rays},

@@ -20,6 +20,7 @@ struct Thresholds {
   double ambiguous_max = 0.25;   // share of ambiguous pixels, at most
   double t_exceeded_max = 0.0;   // share of compared pixels whose t is off by more than allowed
   ImageThresholds image;
+  ColourThresholds colour;             // per region: each object and marker, walls, floor, sky
   double steps_ks_max = 0.05;          // Kolmogorov-Smirnov statistic against the reference
   double steps_mean_ratio_max = 1.05;  // mean steps within this factor of the reference's
   int probe_rays = 8;                  // generic rays traced per case
@@ -27,7 +28,7 @@ struct Thresholds {
   int trace_failures_max = 0;          // probe rays whose trace may diverge
   double trace_error = 1e-2;           // largest |t - t'| and |at - at'|, in units of scene scale
   std::array<double, kFailureClasses> failure_max{};  // share of decided pixels per class
-  std::string why;                                    // the exceptions applied, and why
+  std::string why;  // the method, backend and exception layers applied, and why
 };
 
 // The thresholds.json built into the program.

@@ -214,7 +214,10 @@ TEST(Thresholds, ABadFileNamesTheKey) {
 // The scalar backend with one thing broken on purpose.
 class Broken : public Backend {
  public:
-  enum class Flaw { extra_crossing, phantom_object, leaking_trace };
+  // flat_object: object 0 shaded flat (an explicit colour), not by its normal; swapped_normal:
+  // object 0's pixels with red and green swapped, which is what swapping its normal's x and y
+  // makes of an object coloured by its normal (its light and fog depend on neither).
+  enum class Flaw { extra_crossing, phantom_object, leaking_trace, flat_object, swapped_normal };
   explicit Broken(Flaw flaw) : flaw_(flaw) {}
   std::string name() const override { return "scalar"; }
   std::string description() const override { return "scalar, broken on purpose"; }
@@ -222,11 +225,16 @@ class Broken : public Backend {
   std::vector<Method> methods() const override { return scalar_.methods(); }
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override {
-    Frame f = scalar_.render(scene, camera, width, height, params, progress);
+    Scene flat = scene;
+    if (flaw_ == Flaw::flat_object) flat.objects[0].color = Vec3(0.9, 0.45, 0.5);
+    Frame f = scalar_.render(flat, camera, width, height, params, progress);
     for (size_t px = 0; px < f.hit.size(); px += 7) {
       if (flaw_ == Flaw::extra_crossing) f.crossings[px] += 1.0f;
       if (flaw_ == Flaw::phantom_object && f.hit[px] < 0.0f) f.hit[px] = 0.0f;
     }
+    if (flaw_ == Flaw::swapped_normal)
+      for (size_t px = 0; px < f.hit.size(); ++px)
+        if (f.hit[px] == 0.0f) std::swap(f.rgb[3 * px], f.rgb[3 * px + 1]);
     return f;
   }
   Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
@@ -272,13 +280,31 @@ TEST(Suite, TheScalarBackendPassesAndEachFlawIsCaughtByItsCheck) {
   EXPECT_TRUE(failed(leak, "traces.diverged"));
   EXPECT_GT(leak.trace_failures[static_cast<size_t>(Failure::leak)], 0u);
 
+  // A wrongly shaded object, a few percent of the frame, passes the whole frame's colour checks
+  // (idiff and Yee's metric count over every pixel) and fails its own region's (issue 22).
+  const Scene small = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
+                                            "radius": 0.18}], "camera": {"position": [0.5, 0.7, 1],
+                                            "yaw_deg": 20})");
+  for (const Broken::Flaw f : {Broken::Flaw::flat_object, Broken::Flaw::swapped_normal}) {
+    const CaseResult shaded = suite.run(Broken(f), small, params, 96, 54);
+    for (const RegionColour& r : shaded.regions)
+      if (r.region == Region::object) {
+        EXPECT_LT(r.pixels, 96u * 54u / 50u);  // under 2% of the frame
+      }
+    EXPECT_TRUE(failed(shaded, "colour.object_0")) << static_cast<int>(f);
+    EXPECT_FALSE(failed(shaded, "image.failpercent")) << static_cast<int>(f);
+    EXPECT_FALSE(failed(shaded, "colour.walls")) << static_cast<int>(f);
+    EXPECT_EQ(shaded.verdict, Verdict::fail);
+  }
+
   // Every flaw fails, with sphere tracing too: none is a method's limit (issue 22), which only
   // rays out of steps make.
   for (const Method m : {Method::analytic, Method::sphere, Method::relaxed}) {
     params.method = m;
     EXPECT_EQ(suite.run(ScalarBackend(), scene, params, 64, 36).verdict, Verdict::pass);
     for (const Broken::Flaw f :
-         {Broken::Flaw::extra_crossing, Broken::Flaw::phantom_object, Broken::Flaw::leaking_trace})
+         {Broken::Flaw::extra_crossing, Broken::Flaw::phantom_object, Broken::Flaw::leaking_trace,
+          Broken::Flaw::flat_object, Broken::Flaw::swapped_normal})
       EXPECT_EQ(suite.run(Broken(f), scene, params, 64, 36).verdict, Verdict::fail)
           << to_string(m) << " flaw " << static_cast<int>(f);
   }
