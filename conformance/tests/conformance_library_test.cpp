@@ -8,6 +8,7 @@
 
 #include "backends/scalar/scalar.hpp"
 #include "conformance/suite.hpp"
+#include "output/image_io.hpp"
 #include "scene/load.hpp"
 #include "tests/process.hpp"
 #include "tests/test_scenes.hpp"
@@ -340,8 +341,9 @@ TEST(CliConform, PrintsATableWritesJsonAndExitsByTheVerdict) {
   const std::string dir = test::make_temp_dir();
   const std::string json = dir + "/conform.json";
   const std::string torus = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
-  test::ProcessResult r = test::run_flatmarch(
-      {"conform", "--backend", "scalar", "--scene", torus, "--method", "analytic", "--json", json});
+  test::ProcessResult r =
+      test::run_flatmarch({"conform", "--backend", "scalar", "--scene", torus, "--method",
+                           "analytic", "--json", json, "--error-images", dir + "/agree"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("scalar   torus"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("1 cases: 1 pass, 0 at their method's limit, 0 failed"), std::string::npos)
@@ -352,6 +354,33 @@ TEST(CliConform, PrintsATableWritesJsonAndExitsByTheVerdict) {
   ASSERT_EQ(doc["cases"].size(), 1u);
   EXPECT_EQ(doc["cases"][0]["scene"], "torus");
   EXPECT_EQ(doc["cases"][0]["hit_rate"], 1.0);
+  ASSERT_FALSE(doc["cases"][0]["colour"].empty());
+  EXPECT_EQ(doc["cases"][0]["colour"][0]["region"], "object 0");
+
+  // The error image (sRGB): agreeing pixels grey, ambiguous ones dark blue; with no colour
+  // difference allowed, the pixels in the colour-failure yellow.
+  const auto count = [](const std::string& png, auto&& is) {
+    const Png image = read_png(png);
+    EXPECT_EQ(image.width * image.height, 160 * 90) << png;
+    size_t n = 0;
+    for (size_t px = 0; px < image.rgb.size(); px += 3)
+      n += is(image.rgb[px], image.rgb[px + 1], image.rgb[px + 2]);
+    return n;
+  };
+  const auto grey = [](int red, int green, int blue) { return red == green && green == blue; };
+  const auto yellow = [](int red, int green, int blue) {
+    return red > 240 && green > 200 && green < 235 && blue < 20;
+  };
+  EXPECT_GT(count(dir + "/agree/scalar-torus-analytic.png", grey), 160u * 90u * 9 / 10);
+  EXPECT_EQ(doc["cases"][0]["error_image"], dir + "/agree/scalar-torus-analytic.png");
+  const std::string exact = dir + "/exact.json";
+  std::ofstream(exact) << R"({"defaults": {"colour": {"delta_e": 0, "allowed": 0}}})";
+  r = test::run_flatmarch({"conform", "--backend", "scalar", "--scene", torus, "--method",
+                           "analytic", "--thresholds", exact, "--json", json, "--error-images",
+                           dir + "/errors"});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.out.find("colour.object_0"), std::string::npos) << r.out;
+  EXPECT_GT(count(dir + "/errors/scalar-torus-analytic.png", yellow), 100u);
 
   // Thresholds no backend can meet: the case fails, the check is named, the exit code is 1.
   const std::string strict = dir + "/strict.json";
