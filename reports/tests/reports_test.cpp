@@ -97,6 +97,7 @@ TEST(Statistics, MannWhitneyAsScipyComputesIt) {
 }
 
 // A sweep point as run_sweep writes it.
+// A sweep point; one that does not pass fails hit_rate with some wrong edges.
 json point(const std::string& scene, double eps, const std::string& label, bool passed,
            double time_ms, double mismatch) {
   return {{"scene", scene},
@@ -111,11 +112,28 @@ json point(const std::string& scene, double eps, const std::string& label, bool 
           {"steps_p99", 20.0},
           {"accuracy",
            {{"passed", passed},
+            {"verdict", passed ? "pass" : "fail"},
             {"failed", passed ? json::array() : json::array({"hit_rate"})},
+            {"failures", {{"stuck", 0}, {"wrong_edge", passed ? 0 : 5}}},
             {"hit_mismatch", mismatch},
             {"traces", 8},
             {"traces_diverged", passed ? 0 : 1},
             {"failures_total", passed ? 0 : 5}}}};
+}
+
+// The point at its method's limit: rays out of steps, failing hit_rate and failures.stuck.
+json limit_point(const std::string& scene, double eps, const std::string& label) {
+  json p = point(scene, eps, label, false, 1.0, 0.3);
+  p["accuracy"]["verdict"] = "limit";
+  p["accuracy"]["failed"] = {"hit_rate", "failures.stuck"};
+  p["accuracy"]["failures"] = {{"stuck", 40}, {"wrong_edge", 2}};
+  return p;
+}
+
+const json& cell(const json& group, double eps, const std::string& label) {
+  for (const json& c : group["grid"])
+    if (c["eps"] == eps && c["offset_label"] == label) return c;
+  throw std::runtime_error("no such cell");
 }
 
 TEST(SweepAnalysis, RecommendsTheFastestPointWithStableNeighbours) {
@@ -142,6 +160,65 @@ TEST(SweepAnalysis, RecommendsTheFastestPointWithStableNeighbours) {
     if (cell["eps"] == 1e-2) {
       EXPECT_EQ(cell["passed"], 1);
     }
+}
+
+// Stable means the verdict pass on every scene: a limit is not, and the cell says what made it
+// unstable, a failure class before a check that fails with it.
+TEST(SweepAnalysis, ALimitIsUnstableAndEachCellNamesItsCause) {
+  json points = json::array();
+  for (const std::string scene : {"a", "b"}) {
+    points.push_back(point(scene, 1e-3, "2xeps", true, 1.0, 0.0));
+    points.push_back(point(scene, 1e-2, "2xeps", scene == "a", 1.0, 0.1));
+  }
+  points.push_back(limit_point("a", 1e-4, "2xeps"));
+  points.push_back(point("b", 1e-4, "2xeps", true, 1.0, 0.0));
+  json perceptual = point("a", 1e-5, "2xeps", false, 1.0, 0.0);
+  perceptual["accuracy"]["failed"] = {"image.perceptual_failpercent"};
+  perceptual["accuracy"]["failures"] = {{"stuck", 0}};
+  points.push_back(perceptual);
+  points.push_back(point("b", 1e-5, "2xeps", true, 1.0, 0.0));
+  const json g = analyse_sweep(points)[0];
+  EXPECT_TRUE(cell(g, 1e-3, "2xeps")["stable"].get<bool>());
+  EXPECT_EQ(cell(g, 1e-3, "2xeps")["cause"], "");
+  const json& limit = cell(g, 1e-4, "2xeps");
+  EXPECT_FALSE(limit["stable"].get<bool>());
+  EXPECT_EQ(limit["limits"], 1);
+  EXPECT_EQ(limit["cause"], "stuck");
+  EXPECT_EQ(limit["failed_checks"]["hit_rate"], 1);
+  EXPECT_EQ(limit["failures_by_class"]["stuck"], 40);
+  EXPECT_EQ(cell(g, 1e-2, "2xeps")["cause"], "wrong_edge");
+  // No check is left out, the perceptual one included.
+  EXPECT_FALSE(cell(g, 1e-5, "2xeps")["stable"].get<bool>());
+  EXPECT_EQ(cell(g, 1e-5, "2xeps")["cause"], "image.perceptual_failpercent");
+  // The only stable point has no stable eps neighbours: a fallback, marked.
+  EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-3);
+  EXPECT_TRUE(g["recommended"]["fallback"].get<bool>());
+  EXPECT_TRUE(g["recommended"]["confirmed"].is_null());
+}
+
+// A recommended point whose re-check at a larger size fails is no longer stable: the next is
+// recommended; one that passes it carries it.
+TEST(SweepAnalysis, AFailedRecheckMovesTheRecommendation) {
+  json points = json::array();
+  const double eps[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6};
+  for (int e = 0; e < 5; ++e) points.push_back(point("a", eps[e], "2xeps", true, 1.0 + e, 0.0));
+  const json first = analyse_sweep(points)[0]["recommended"];
+  ASSERT_EQ(first["eps"].get<double>(), 1e-3);  // the fastest with both neighbours stable
+  EXPECT_FALSE(first["fallback"].get<bool>());
+  const json recheck = {
+      {"surface_type", "translation"}, {"method", "sphere"}, {"precision", "f32"}, {"eps", 1e-3},
+      {"offset_label", "2xeps"},       {"size", "128x72"},   {"passed", false}};
+  const json g = analyse_sweep(points, json::array({recheck}))[0];
+  EXPECT_FALSE(cell(g, 1e-3, "2xeps")["stable"].get<bool>());
+  EXPECT_EQ(cell(g, 1e-3, "2xeps")["cause"], "confirmation");
+  // 1e-4 has lost its stable neighbour 1e-3: of the interior points only 1e-5 is left.
+  EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-5);
+  json passed = recheck;
+  passed["eps"] = 1e-5;
+  passed["passed"] = true;
+  const json again = analyse_sweep(points, json::array({recheck, passed}))[0]["recommended"];
+  EXPECT_EQ(again["eps"].get<double>(), 1e-5);
+  EXPECT_EQ(again["confirmed"]["size"], "128x72");
 }
 
 TEST(SweepAnalysis, NothingStableRecommendsNothing) {
@@ -479,6 +556,11 @@ TEST(SweepCommand, FindsTheDefaultsStableAndAHugeEpsNot) {
   const json& g = sweep["analysis"][0];
   EXPECT_EQ(g["surface_type"], "translation");
   EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-4) << g.dump();
+  // Re-checked at twice the size on the torus, where it passes too.
+  EXPECT_EQ(sweep["options"]["confirm_size"], "96x54");
+  ASSERT_FALSE(g["recommended"]["confirmed"].is_null()) << g.dump();
+  EXPECT_EQ(g["recommended"]["confirmed"]["size"], "96x54");
+  EXPECT_EQ(g["recommended"]["confirmed"]["scenes"]["torus"]["verdict"], "pass");
 }
 
 }  // namespace
