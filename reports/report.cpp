@@ -196,21 +196,37 @@ json recommend(const json& ranking, const json& sweep) {
       "method of those that passed on every scene";
   const MarchParams defaults;
   json parameters = json::object();
+  const json analysis = sweep.value("analysis", json::array());
   // The surface types the sweep measured; `select` gives the defaults for the others.
   for (const std::string& type : surface_types()) {
-    const json analysis = sweep.value("analysis", json::array());
     if (std::none_of(analysis.begin(), analysis.end(),
                      [&](const json& g) { return g["surface_type"] == type; }))
       continue;
-    json choice = {{"eps", defaults.eps}, {"offset", defaults.offset}, {"source", "defaults"}};
-    for (const json& g : sweep.value("analysis", json::array()))
-      if (g["surface_type"] == type && g["method"] == r["method"] && g["precision"] == "f32" &&
-          !g["recommended"].is_null()) {
-        choice = {{"eps", g["recommended"]["eps"]},
-                  {"offset", g["recommended"]["offset"]},
-                  {"offset_label", g["recommended"]["offset_label"]},
-                  {"source", "sweep"}};
-      }
+    // A fallback is marked as one: the defaults where the method has no stable point, or a
+    // stable point none of whose eps neighbours is stable. With the defaults come the methods
+    // that are stable on this surface type (f32, as the kernel backends march).
+    json choice = {{"eps", defaults.eps},
+                   {"offset", defaults.offset},
+                   {"source", "defaults"},
+                   {"fallback", true},
+                   {"stable_methods", json::array()}};
+    json stable_methods = json::array();
+    for (const json& g : analysis) {
+      if (g["surface_type"] != type || g["precision"] != "f32" || g["recommended"].is_null())
+        continue;
+      const json& rec = g["recommended"];
+      if (g["method"] == r["method"])
+        choice = {{"eps", rec["eps"]},
+                  {"offset", rec["offset"]},
+                  {"offset_label", rec["offset_label"]},
+                  {"source", "sweep"},
+                  {"fallback", rec.value("fallback", false)},
+                  {"confirmed", rec.value("confirmed", json(nullptr))}};
+      else
+        stable_methods.push_back(
+            {{"method", g["method"]}, {"eps", rec["eps"]}, {"offset", rec["offset"]}});
+    }
+    if (choice["source"] == "defaults") choice["stable_methods"] = stable_methods;
     parameters[type] = choice;
   }
   r["parameters"] = parameters;
@@ -232,10 +248,21 @@ std::string describe_selection(const json& results, const std::string& type) {
            rec["backend"].get<std::string>() + " --method " + rec["method"].get<std::string>() +
            " --eps " + number(p["eps"]) + " --offset " + number(p["offset"]) + note + "\n";
   };
-  for (const auto& [t, p] : rec["parameters"].items())
-    if (type.empty() || t == type)
-      s += line_for(t, p,
-                    p["source"] == "sweep" ? "" : "   (defaults: the sweep found no stable point)");
+  for (const auto& [t, p] : rec["parameters"].items()) {
+    if (!type.empty() && t != type) continue;
+    std::string note;
+    if (p["source"] != "sweep") {
+      note = "   (a fallback, the defaults: no point of the sweep passes on every " + t +
+             " scene with this method";
+      for (const json& m : p.value("stable_methods", json::array()))
+        note += "; stable there: --method " + m["method"].get<std::string>() + " --eps " +
+                number(m["eps"]) + " --offset " + number(m["offset"]);
+      note += ")";
+    } else if (p.value("fallback", false)) {
+      note = "   (a fallback: no stable point of the sweep has stable eps neighbours)";
+    }
+    s += line_for(t, p, note);
+  }
   if (!type.empty() && !rec["parameters"].contains(type)) {
     const MarchParams defaults;
     s += line_for(type, {{"eps", defaults.eps}, {"offset", defaults.offset}},

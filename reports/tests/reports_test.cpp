@@ -268,6 +268,59 @@ TEST(Ranking, ConformingBackendsFirstThenBySpeed) {
   EXPECT_TRUE(rec["parameters"].empty());  // no sweep: select falls back to the defaults
 }
 
+// Where the recommended method has no stable point on a surface type, select falls back to the
+// defaults, says so, and names the method that is stable there; a sweep point without stable
+// neighbours is a fallback too.
+TEST(Ranking, AFallbackIsMarkedAndNamesTheStableMethod) {
+  json cases = json::array();
+  for (const std::string scene : {"x", "y"}) {
+    cases.push_back(matrix_case("scalar", "sphere", scene, 4e6, true, 10));
+    cases.push_back(matrix_case("scalar", "analytic", scene, 1e6, true, 3));
+  }
+  const json ranking = rank_backends({{"cases", cases}});
+  const auto group = [](const std::string& type, const std::string& method, json recommended) {
+    return json{{"surface_type", type},
+                {"method", method},
+                {"precision", "f32"},
+                {"recommended", recommended}};
+  };
+  const json sweep = {
+      {"analysis",
+       {group("prism", "sphere", nullptr),
+        group("prism", "analytic",
+              {{"eps", 1e-5}, {"offset", 1e-4}, {"offset_label", "10xeps"}, {"fallback", false}}),
+        group("translation", "sphere",
+              {{"eps", 1e-3}, {"offset", 2e-3}, {"offset_label", "2xeps"}, {"fallback", true}})}}};
+  const json rec = recommend(ranking, sweep);
+  ASSERT_EQ(rec["method"], "sphere");
+  const json& prism = rec["parameters"]["prism"];
+  EXPECT_EQ(prism["source"], "defaults");
+  EXPECT_TRUE(prism["fallback"].get<bool>());
+  ASSERT_EQ(prism["stable_methods"].size(), 1u);
+  EXPECT_EQ(prism["stable_methods"][0]["method"], "analytic");
+  const json& translation = rec["parameters"]["translation"];
+  EXPECT_EQ(translation["source"], "sweep");
+  EXPECT_TRUE(translation["fallback"].get<bool>());
+  const json results = {
+      {"recommendation", rec},
+      {"ranking", ranking},
+      {"fingerprint",
+       {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
+        {"vulkan", json::object()},
+        {"opengl", json::object()}}}};
+  const std::string text = describe_selection(results, "");
+  EXPECT_NE(text.find("prism       --backend scalar --method sphere --eps 0.0001 --offset 0.0002"
+                      "   (a fallback, the defaults: no point of the sweep passes on every prism "
+                      "scene with this method; stable there: --method analytic --eps 1e-05 "
+                      "--offset 0.0001)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("--eps 0.001 --offset 0.002   (a fallback: no stable point of the sweep has "
+                      "stable eps neighbours)"),
+            std::string::npos)
+      << text;
+}
+
 TEST(Ranking, SimdShareOfPeakIsTheGeometricMeanPerMethod) {
   json cases = json::array();
   for (const auto& [scene, share] : {std::pair{"x", 0.2}, std::pair{"y", 0.8}}) {
