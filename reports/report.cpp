@@ -9,6 +9,7 @@
 #include <set>
 
 #include "reports/fingerprint.hpp"
+#include "reports/gallery.hpp"
 #include "reports/surfaces.hpp"
 
 namespace flatmarch::reports {
@@ -40,7 +41,9 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
   // The lists make_report.py draws by (it restates none).
   json methods = json::array();
   for (Method m : kKernelMethods) methods.push_back(to_string(m));
-  results["registry"] = {{"backends", kernel_backend_names()}, {"methods", methods}};
+  results["registry"] = {{"backends", kernel_backend_names()},
+                         {"methods", methods},
+                         {"surface_types", surface_types()}};
   results["options"] = {
       {"size", std::to_string(o.matrix.width) + "x" + std::to_string(o.matrix.height)},
       {"conform_size",
@@ -85,6 +88,14 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
   results["seconds"]["scaling"] = lap();
   results["ranking"] = rank_backends(results["matrix"]);
   results["recommendation"] = recommend(results["ranking"], results.value("sweep", json::object()));
+  if (!o.matrix.images.empty())
+    results["gallery"] = recommended_gallery(scenes, results["recommendation"],
+                                             {.width = o.matrix.width,
+                                              .height = o.matrix.height,
+                                              .params = o.matrix.params,
+                                              .backend_options = o.matrix.backend_options,
+                                              .images = o.matrix.images});
+  results["seconds"]["gallery"] = lap();
   return results;
 }
 

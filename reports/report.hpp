@@ -28,7 +28,8 @@ using ReportProgress =
     std::function<void(const std::string& stage, const std::string& line, int done, int total)>;
 
 // Runs what the options ask on the scenes and returns the results document: "format",
-// "created", "fingerprint", "options", "matrix", "sweep", "scaling", "ranking", "recommendation".
+// "created", "fingerprint", "options", "matrix", "sweep", "scaling", "ranking", "recommendation",
+// and with matrix images, "gallery" (recommended_gallery()).
 nlohmann::json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
                           const ReportProgress& progress);
 

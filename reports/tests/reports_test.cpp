@@ -7,6 +7,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "output/image_io.hpp"
+#include "reports/gallery.hpp"
 #include "reports/report.hpp"
 #include "reports/surfaces.hpp"
 #include "scene/load.hpp"
@@ -301,13 +303,12 @@ TEST(Ranking, AFallbackIsMarkedAndNamesTheStableMethod) {
   const json& translation = rec["parameters"]["translation"];
   EXPECT_EQ(translation["source"], "sweep");
   EXPECT_TRUE(translation["fallback"].get<bool>());
-  const json results = {
-      {"recommendation", rec},
-      {"ranking", ranking},
-      {"fingerprint",
-       {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
-        {"vulkan", json::object()},
-        {"opengl", json::object()}}}};
+  const json results = {{"recommendation", rec},
+                        {"ranking", ranking},
+                        {"fingerprint",
+                         {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
+                          {"vulkan", json::object()},
+                          {"opengl", json::object()}}}};
   const std::string text = describe_selection(results, "");
   EXPECT_NE(text.find("prism       --backend scalar --method sphere --eps 0.0001 --offset 0.0002"
                       "   (a fallback, the defaults: no point of the sweep passes on every prism "
@@ -416,6 +417,59 @@ TEST(Gate, SlowerTimingsWarnOnlyWhenSignificant) {
   EXPECT_NEAR(check["timing_warnings"][0]["ratio"].get<double>(), 1.5, 0.02);
   EXPECT_TRUE(check["regressions"].empty());  // timings never fail the gate
   EXPECT_FALSE(check["same_machine"].get<bool>());
+}
+
+// The recommended method's gallery: its image and a map of where it differs from the oracle,
+// whose classes count every pixel; a method far off (eps 0.1, offset 1: a push skips a quarter
+// of the room) shows its failures in their colours.
+TEST(Gallery, TheDifferenceMapCountsEveryPixelAndShowsFailures) {
+  const fs::path dir = test::make_temp_dir();
+  const std::vector<Scene> scenes = {gallery("torus")};
+  json rec = {{"backend", "scalar"}, {"method", "analytic"}, {"parameters", json::object()}};
+  GalleryOptions o;
+  o.width = 48;
+  o.height = 27;
+  o.images = dir;
+  const size_t pixels = 48 * 27;
+  const auto total = [](const json& counts) {
+    size_t n = 0;
+    for (const auto& [k, v] : counts.items()) n += v.get<size_t>();
+    return n;
+  };
+  json g = recommended_gallery(scenes, rec, o);
+  ASSERT_EQ(g["scenes"].size(), 1u);
+  json s = g["scenes"][0];
+  ASSERT_FALSE(s.contains("error")) << s.dump();
+  EXPECT_EQ(s["eps"].get<double>(), MarchParams{}.eps);
+  EXPECT_TRUE(fs::exists(dir / s["image"].get<std::string>()));
+  EXPECT_EQ(total(s["counts"]), pixels);
+  EXPECT_GE(s["counts"]["agree"].get<size_t>(), pixels * 95 / 100) << s.dump();
+  EXPECT_EQ(s["counts"]["stuck"], 0);
+
+  rec["method"] = "sphere";
+  rec["parameters"]["translation"] = {{"eps", 0.1}, {"offset", 1.0}};
+  g = recommended_gallery(scenes, rec, o);
+  s = g["scenes"][0];
+  EXPECT_EQ(s["eps"].get<double>(), 0.1);
+  EXPECT_EQ(total(s["counts"]), pixels);
+  const size_t failed = pixels - s["counts"]["agree"].get<size_t>() -
+                        s["counts"]["ambiguous"].get<size_t>() -
+                        s["counts"]["colour"].get<size_t>();
+  EXPECT_GT(failed, pixels / 100) << s.dump();
+  // Every pixel of the map that is a failure's colour is counted as that failure.
+  const Png diff = read_png(dir / s["diff"].get<std::string>());
+  ASSERT_EQ(diff.width, 48);
+  size_t painted = 0;
+  for (const json& entry : g["legend"]) {
+    const std::string name = entry["class"], hex = entry["colour"];
+    if (name == "agree" || name == "ambiguous" || name == "colour") continue;
+    const int r = std::stoi(hex.substr(1, 2), nullptr, 16),
+              gr = std::stoi(hex.substr(3, 2), nullptr, 16),
+              b = std::stoi(hex.substr(5, 2), nullptr, 16);
+    for (size_t px = 0; px < pixels; ++px)
+      painted += diff.rgb[3 * px] == r && diff.rgb[3 * px + 1] == gr && diff.rgb[3 * px + 2] == b;
+  }
+  EXPECT_EQ(painted, failed);
 }
 
 // The commands end to end, on the torus and the scalar backend at a small size.
