@@ -343,6 +343,15 @@ json make_baseline(const json& results) {
           {"timings_ms", timings}};
 }
 
+std::string baseline_mismatch(const json& baseline, const json& results) {
+  if (baseline.value("format", "") != "flatmarch-baseline/1") return "it is not a baseline file";
+  for (const char* key : {"size", "conform_size", "eps", "offset", "max_steps"})
+    if (baseline["options"][key] != results["options"][key])
+      return "it was measured with " + std::string(key) + " " + baseline["options"][key].dump() +
+             ", this run with " + results["options"][key].dump();
+  return "";
+}
+
 double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b) {
   const size_t n1 = a.size(), n2 = b.size(), n = n1 + n2;
   if (n1 < 2 || n2 < 2) return 1.0;

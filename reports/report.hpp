@@ -51,6 +51,10 @@ std::string describe_selection(const nlohmann::json& results, const std::string&
 // rates), with the tolerances they are held to, and the timing samples (informative only).
 nlohmann::json make_baseline(const nlohmann::json& results);
 
+// Why `baseline` cannot judge `results` (not a baseline file, or measured at another size,
+// conform size, eps, offset or max_steps), or "" when it can.
+std::string baseline_mismatch(const nlohmann::json& baseline, const nlohmann::json& results);
+
 // Compares results with a baseline: "regressions" (a deterministic figure worse beyond its
 // tolerance, or a case that passed now failing), "improvements" (better beyond tolerance: the
 // baseline wants updating), "missing" (cases of the baseline not measured now), and

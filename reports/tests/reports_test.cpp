@@ -511,6 +511,11 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_TRUE(c["accuracy"]["passed"].get<bool>());
   EXPECT_GT(c["counters"]["steps_mean"].get<double>(), 1.0);
   EXPECT_EQ(results["recommendation"]["backend"], "scalar");
+  // No --baseline: the committed one was measured at another size, so nothing is checked, and
+  // the page will say why.
+  EXPECT_FALSE(results["regression"]["checked"].get<bool>());
+  EXPECT_NE(results["regression"]["why"].get<std::string>().find("size"), std::string::npos)
+      << results["regression"];
 
   const auto s = test::run_flatmarch({"select", dir + "/results.json", "--scene", torus});
   ASSERT_EQ(s.exit_code, 0) << s.err;
@@ -530,6 +535,12 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_EQ(g.exit_code, 0) << g.out << g.err;
   EXPECT_NE(g.out.find("gate: 1 cases compared"), std::string::npos) << g.out;
   EXPECT_NE(g.out.find("0 regressions"), std::string::npos) << g.out;
+  std::ifstream again(dir + "/again/results.json");
+  const json regression = json::parse(again)["regression"];
+  EXPECT_TRUE(regression["checked"].get<bool>()) << regression;
+  EXPECT_TRUE(regression["given"].get<bool>());
+  EXPECT_EQ(regression["compared"], 1);
+  EXPECT_TRUE(regression["regressions"].empty());
 
   // The page of one run, and the page comparing two (both runs here, for the test).
   const auto page = test::run_flatmarch({"report", dir + "/results.json", "-o", dir + "/page"});
@@ -547,6 +558,16 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_NE(text2.find("machines compared"), std::string::npos);
   // One common case, on the CPU on both machines.
   EXPECT_NE(text2.find("<td>scalar</td><td>CPU</td><td>CPU</td><td>1</td>"), std::string::npos);
+
+  // An earlier run to compare with must be a results file.
+  const auto not_results = test::run_flatmarch(
+      {"report", dir + "/results.json", "-o", dir + "/page", "--previous", dir + "/baseline.json"});
+  EXPECT_EQ(not_results.exit_code, 2);
+  EXPECT_NE(not_results.err.find("--previous: " + dir +
+                                 "/baseline.json has no \"matrix\": not a "
+                                 "results file of `flatmarch report`"),
+            std::string::npos)
+      << not_results.err;
 
   const auto bad = test::run_flatmarch({"select", dir + "/nothing.json"});
   EXPECT_EQ(bad.exit_code, 2);
