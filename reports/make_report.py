@@ -67,6 +67,17 @@ CHECKS = {
 }
 CHECKS.update({f"failures.{f}": f"decided pixels that {m}, of the decided pixels"
                for f, m in FAILURE_MEANINGS.items() if f != "leak"})
+# The short code each cause of an unstable sweep point gets in its heatmap cell.
+CAUSE_CODES = {
+    "stuck": "st", "wrong_edge": "we", "missed_object": "mo", "phantom_hit": "ph", "early_escape": "ee",
+    "late_escape": "le", "leak": "lk", "hit_rate": "hr", "crossings_rate": "cr", "ambiguous": "am",
+    "t.exceeded": "t", "most_steps": "ms", "image.failpercent": "im", "image.max_error": "mx",
+    "image.perceptual_failpercent": "pe", "steps.ks": "ks", "steps.mean_ratio": "sr",
+    "traces.diverged": "tr", "traces.error": "te", "error": "err",
+    "confirmation": "rc",
+}
+CAUSE_MEANINGS = dict(FAILURE_MEANINGS, **CHECKS, error="the backend failed to render",
+                      confirmation="passes at the sweep's size but fails its re-check at the larger size")
 # Issue 22's goals for the ambiguous share at default parameters, per method, in prisms and elsewhere
 # (None: no goal).
 AMBIGUITY_GOALS = {"analytic": {"prism": 0.05, "other": 0.05},
@@ -706,19 +717,38 @@ def sweep_section(sweep):
     opts = sweep["options"]
     labels = opts["offset_labels"]
     eps_values = sorted(opts["eps"], reverse=True)
+    confirm = opts.get("confirm_size")
+    codes = sorted({c.get("cause", "") for g in analysis for c in g["grid"] if not c["stable"]} - {""},
+                   key=lambda k: list(CAUSE_CODES).index(k) if k in CAUSE_CODES else len(CAUSE_CODES))
+    legend = table(["code", "what made the point unstable"],
+                   [[f"<td><b>{esc(CAUSE_CODES.get(k, k[:3]))}</b></td>", f"{k}: {CAUSE_MEANINGS.get(k, '')}"]
+                    for k in codes])
     out = [f"<h2 id=sweep>eps &times; offset sweep</h2><p>The {esc(opts['backend'])} backend at {esc(opts['size'])} "
-           "over hit thresholds eps and re-entry offsets (multiples of eps, and fixed values), each point judged "
-           "against one truth (the oracle, masked as for the default parameters). <b>Stability</b> heatmaps: the "
-           "colour is the share of decided pixels whose hit is wrong (mean over the surface type's scenes, log); "
-           "a tick marks a stable point (every scene passes the conformance checks but the perceptual one, "
-           "which small frames make noisy; a tick on a coloured cell is an error conformance/thresholds.json allows "
-           "with its reason, such as sphere tracing running out of steps near the horizon, on up to 2% of the "
-           "pixels of several scenes and most of a translation prism's); the star, the recommendation: of the stable points whose "
-           "neighbours a decade of eps either side are stable too, one within 10% of the fastest with the most stable "
-           "neighbours on the grid. <b>Steps</b> heatmaps: mean kernel steps per "
-           "ray. The Pareto chart: each grid point's time against its error; the front joins the points no other "
-           "beats on both.</p>"]
+           f"({opts['repetitions']} timed frames a point) over hit thresholds eps and re-entry offsets (multiples of "
+           "eps, and fixed values), each point judged by the conformance suite against one truth (the oracle, "
+           "masked as for the default parameters). A point is <b>stable</b> when its verdict is <b>pass</b> on "
+           "every swept scene of the surface type: no check is left out, and a point at its method's limit is "
+           "not stable.</p>"
+           "<p><b>Stability</b> heatmaps: the colour is the share of decided pixels whose hit is wrong (mean over "
+           "the type's scenes, log); a tick marks a stable point; an unstable point shows what made it "
+           "unstable: the failure class whose threshold the most scenes fail, else (when the hit, crossings or "
+           "trace agreement fails) the class with the most rays, else the check the most scenes fail, as a code "
+           "(legend below) in white where a scene fails and in yellow where every scene that does not pass is "
+           "at the method's limit. The star is the recommendation: of the stable points whose neighbours a "
+           "decade of eps either side are stable too, one within 10% of the fastest with the most stable "
+           "neighbours on the grid; an orange star is a <b>fallback</b>, a stable point none of whose eps "
+           "neighbours is stable. <b>Steps</b> heatmaps: mean kernel steps per ray. The Pareto chart: each grid "
+           "point's time against its error; the front joins the points no other beats on both.</p>"
+           "<p><b>Not noise.</b> Stability is the conformance verdict, which does not depend on timing; the "
+           "timings only choose among stable points within 10% of each other, all of which pass. What small "
+           "frames can change is the verdict itself (a few rays more or less near a threshold), so "
+           + (f"each recommended point was rendered again at {esc(confirm)} on every swept scene of its type, "
+              "and a point that failed there was dropped and the next one chosen (code rc); the table says "
+              "which points were re-checked."
+              if confirm else "these results, written without a re-check at a larger size, may hold a point "
+              "that passes only at this size.") + "</p>" + legend]
     rec_rows = []
+    no_stable = []
     types = [t for t in SURFACE_TYPES if any(g["surface_type"] == t for g in analysis)]
     for t in types:
         groups = [g for g in analysis if g["surface_type"] == t]
@@ -755,13 +785,20 @@ def sweep_section(sweep):
                             if c and what == "stability" and c["stable"]:
                                 ax.text(k, r, "\u2713", ha="center", va="center", color="#33ff77", fontsize=11,
                                         fontweight="bold", path_effects=[withStroke(linewidth=2, foreground="black")])
+                            elif c and what == "stability":
+                                cause = c.get("cause", "")
+                                at_limit = c.get("limits", 0) > 0 and \
+                                    c.get("limits", 0) == c["scenes"] - c["passed"] - c["errors"]
+                                ax.text(k, r, CAUSE_CODES.get(cause, cause[:3]), ha="center", va="center",
+                                        fontsize=7.5, color="#ffd700" if at_limit else "white",
+                                        path_effects=[withStroke(linewidth=1.6, foreground="black")])
                             if c and what == "steps" and not math.isnan(grid[r][k]):
                                 ax.text(k, r, f"{grid[r][k]:.0f}", ha="center", va="center", fontsize=6,
                                         color="white" if grid[r][k] < 40 else "black")
                     rec = g.get("recommended")
                     if rec:
                         ax.plot(labels.index(rec["offset_label"]), eps_values.index(rec["eps"]), marker="*",
-                                ms=16, mfc="none", mec="#00bfff", mew=2)
+                                ms=16, mfc="none", mec="#ff8c00" if rec.get("fallback") else "#00bfff", mew=2)
                     ax.set_xticks(range(len(labels)), labels, rotation=60, fontsize=7)
                     ax.set_yticks(range(len(eps_values)), [f"{e:g}" for e in eps_values], fontsize=7)
                     ax.set_title(f"{m}, {prec}", fontsize=9)
@@ -794,12 +831,42 @@ def sweep_section(sweep):
             ax.legend(fontsize=7)
         fig.tight_layout()
         out.append(figure_html(fig, f"pareto, {t}"))
+        stable_methods = {g["precision"]: [] for g in groups}
+        for g in groups:
+            if g.get("recommended"):
+                stable_methods[g["precision"]].append(g["method"])
         for g in groups:
             r = g.get("recommended")
-            rec_rows.append([t, g["method"], g["precision"], f'{len(g["stable"])}/{len(g["grid"])}',
-                             f'{r["eps"]:g}' if r else "-", f'{r["offset"]:g} ({r["offset_label"] if r["offset_label"].endswith("xeps") else "fixed"})' if r else "-",
-                             (f'{r["time_ms"]:.3g} ms, {pct(r["hit_mismatch"])} wrong' if r else "nothing stable")])
-    out.insert(1, table(["surface type", "method", "precision", "stable points", "eps", "offset", "at"], rec_rows))
+            if r:
+                k = r.get("confirmed")
+                check = (f'passes at {esc(k["size"])} on {len(k["scenes"])} scene(s)' if k else
+                         "not re-checked")
+                note = "<b>fallback</b>: no stable eps neighbour" if r.get("fallback") else ""
+                rec_rows.append([t, g["method"], g["precision"], f'{len(g["stable"])}/{len(g["grid"])}',
+                                 f'{r["eps"]:g}', f'{r["offset"]:g} ({r["offset_label"] if r["offset_label"].endswith("xeps") else "fixed"})',
+                                 f'{r["time_ms"]:.3g} ms, {pct(r["hit_mismatch"])} hit wrong', check,
+                                 f'<td class="{"limit" if note else ""}">{note}</td>'])
+                continue
+            others = [m for m in stable_methods[g["precision"]] if m != g["method"]]
+            causes = {}
+            for c in g["grid"]:
+                if c.get("cause"):
+                    causes[c["cause"]] = causes.get(c["cause"], 0) + 1
+            top = max(causes, key=causes.get) if causes else None
+            advice = (f'use <b>{esc(others[0])}</b>, which is stable here' + (
+                f' (or {esc(", ".join(others[1:]))})' if others[1:] else "") if others
+                else "no method is stable here")
+            rec_rows.append([t, g["method"], g["precision"], f'0/{len(g["grid"])}', "-", "-",
+                             f'<td class="bad">nothing stable{f": mostly {esc(top)}" if top else ""}</td>', "-",
+                             f"<td>{advice}</td>"])
+            no_stable.append(f'<b>{esc(g["method"])}</b> ({esc(g["precision"])}) on {esc(t)} surfaces: no point of '
+                             f'the grid passes on every scene{f" (most often: {esc(top)})" if top else ""}; '
+                             + advice)
+    out.insert(1, table(["surface type", "method", "precision", "stable points", "eps", "offset", "at",
+                         "re-check", "note"], rec_rows))
+    if no_stable:
+        out.insert(2, '<p class="bad">Where no point is stable:</p><ul>'
+                   + "".join(f"<li>{x}.</li>" for x in no_stable) + "</ul>")
     return "\n".join(out)
 
 
