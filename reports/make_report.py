@@ -553,10 +553,11 @@ def regression_section(results):
                    "purpose: <code>reports/gate.sh --write</code>)</summary>" + table(header, rows_of(improvements))
                    + "</details>")
     if r["timing_warnings"]:
-        out.append("<h3>Slower timings (informative)</h3>" + table(
-            ["case", "baseline ms", "now ms", "ratio", "p"],
-            [[w["case"], f'{w["was_ms"]:.3g}', f'{w["now_ms"]:.3g}', f'{w["ratio"]:.2f}', f'{w["p_value"]:.2g}']
-             for w in r["timing_warnings"]]))
+        out.append(f'<details><summary>{len(r["timing_warnings"])} cases slower than the baseline (informative: '
+                   "a busy machine slows every case)</summary>" + table(
+                       ["case", "baseline ms", "now ms", "ratio", "p"],
+                       [[w["case"], f'{w["was_ms"]:.3g}', f'{w["now_ms"]:.3g}', f'{w["ratio"]:.2f}',
+                         f'{w["p_value"]:.2g}'] for w in r["timing_warnings"]]) + "</details>")
         if not r.get("same_machine", True):
             out.append("<p>The baseline's timings come from another CPU: compare them with care.</p>")
     return "\n".join(out)
@@ -566,12 +567,19 @@ def previous_section(results, previous, previous_path):
     """The change per case since an earlier run: verdict changes first, then the figures."""
     if previous is None:
         return ""
-    now = {c["name"]: c for c in results.get("matrix", {}).get("cases", [])}
-    was = {c["name"]: c for c in previous.get("matrix", {}).get("cases", [])}
-    common = [n for n in now if n in was]
+    # Cases by backend, method and scene: the case name also carries the timed frame size.
+    def key(c):
+        return c["backend"], c["method"], c["scene"]
+    now = {key(c): c for c in results.get("matrix", {}).get("cases", [])}
+    was = {key(c): c for c in previous.get("matrix", {}).get("cases", [])}
+    common = [k for k in now if k in was]
+    sizes = [(r.get("options", {}).get("size"), r.get("options", {}).get("conform_size")) for r in (previous, results)]
     out = [f"<h2 id=previous>Since the earlier run</h2><p>Compared with {esc(previous_path)} (measured "
-           f"{esc(previous.get('created', '?'))}): {len(common)} cases in both, {len(now) - len(common)} new, "
-           f"{len(was) - len(common)} no longer measured.</p>"]
+           f"{esc(previous.get('created', '?'))}): {len(common)} cases (backend, method, scene) in both, "
+           f"{len(now) - len(common)} new, {len(was) - len(common)} no longer measured."
+           + (f" The earlier run timed frames of {esc(sizes[0][0])} and judged {esc(sizes[0][1])}, this one "
+              f"{esc(sizes[1][0])} and {esc(sizes[1][1])}: compare with care." if sizes[0] != sizes[1] else "")
+           + "</p>"]
     rank = {"pass": 0, "limit": 1, "fail": 2, "error": 3, None: -1}
     changed = [(n, verdict(was[n]), verdict(now[n])) for n in common if verdict(was[n]) != verdict(now[n])]
     changed.sort(key=lambda x: (rank[x[1]] >= rank[x[2]], x[0]))  # worse first
@@ -580,7 +588,7 @@ def previous_section(results, previous, previous_path):
         for n, before, after in changed:
             a = now[n].get("accuracy", {})
             why = "<br>".join(reason_html(x) for x in a.get("failed_checks", [])) or esc(now[n].get("error", ""))
-            rows.append([n, f"<td>{verdict_html(before or 'not judged')}</td>",
+            rows.append([now[n]["name"], f"<td>{verdict_html(before or 'not judged')}</td>",
                          f"<td>{verdict_html(after or 'not judged')}</td>",
                          "worse" if rank[after] > rank[before] else "better", f"<td>{why}</td>"])
         out.append("<h3>Verdicts that changed</h3>" +
@@ -614,7 +622,7 @@ def previous_section(results, previous, previous_path):
                + ("" if same_cpu else ", measured on another CPU: compare with care") + ".</p>")
     if rows:
         out.append(table(["case", "hit wrong", "ambiguous", "speed"],
-                         [[n, delta(h), delta(a), f"{s:.3g}x" if s else "-"] for n, h, a, s in rows]))
+                         [[now[n]["name"], delta(h), delta(a), f"{s:.3g}x" if s else "-"] for n, h, a, s in rows]))
     else:
         out.append("<p>No figure moved beyond these bounds.</p>")
     return "\n".join(out)
