@@ -202,9 +202,16 @@ json recommend(const json& ranking, const json& sweep) {
   r["backend"] = (*top)["backend"];
   r["method"] = (*top)["best_method"];
   r["rays_per_s"] = (*top)["methods"][(*top)["best_method"].get<std::string>()]["rays_per_s"];
-  r["why"] =
-      "the fastest backend of those that passed every conformance case, with its fastest "
-      "method of those that passed on every scene";
+  // Said as it is: when no backend passed every case (a case at its method's limit is no pass),
+  // the choice is the fastest backend with a method that passed on every scene.
+  r["why"] = (*top)["passed"] == (*top)["cases"]
+                 ? "the fastest backend of those that passed every conformance case, with its "
+                   "fastest method of those that passed on every scene"
+                 : "no backend passed every conformance case (" +
+                       std::to_string((*top)["cases"].get<int>() - (*top)["passed"].get<int>()) +
+                       " of this one's did not pass, " + std::to_string((*top).value("limits", 0)) +
+                       " of them at their method's limit): the fastest backend with a method that "
+                       "passed on every scene, and its fastest such method";
   const MarchParams defaults;
   json parameters = json::object();
   const json analysis = sweep.value("analysis", json::array());

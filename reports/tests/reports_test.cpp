@@ -270,6 +270,22 @@ TEST(Ranking, ConformingBackendsFirstThenBySpeed) {
   EXPECT_TRUE(rec["parameters"].empty());  // no sweep: select falls back to the defaults
 }
 
+// When no backend passes every case, the recommendation does not say it does.
+TEST(Ranking, ARecommendationWithoutAConformingBackendSaysSo) {
+  json cases = json::array();
+  for (const std::string scene : {"x", "y"}) {
+    cases.push_back(matrix_case("cpu", "sphere", scene, 2e6, scene == "x", 10));
+    cases.back()["accuracy"]["verdict"] = scene == "x" ? "pass" : "limit";
+    cases.push_back(matrix_case("cpu", "analytic", scene, 1e6, true, 3));
+  }
+  const json rec = recommend(rank_backends({{"cases", cases}}), json::object());
+  EXPECT_EQ(rec["method"], "analytic");
+  EXPECT_EQ(rec["why"],
+            "no backend passed every conformance case (1 of this one's did not pass, 1 of them at "
+            "their method's limit): the fastest backend with a method that passed on every scene, "
+            "and its fastest such method");
+}
+
 // Where the recommended method has no stable point on a surface type, select falls back to the
 // defaults, says so, and names the method that is stable there; a sweep point without stable
 // neighbours is a fallback too.
@@ -295,6 +311,8 @@ TEST(Ranking, AFallbackIsMarkedAndNamesTheStableMethod) {
               {{"eps", 1e-3}, {"offset", 2e-3}, {"offset_label", "2xeps"}, {"fallback", true}})}}};
   const json rec = recommend(ranking, sweep);
   ASSERT_EQ(rec["method"], "sphere");
+  EXPECT_EQ(
+      rec["why"].get<std::string>().rfind("the fastest backend of those that passed every", 0), 0u);
   const json& prism = rec["parameters"]["prism"];
   EXPECT_EQ(prism["source"], "defaults");
   EXPECT_TRUE(prism["fallback"].get<bool>());
