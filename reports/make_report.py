@@ -186,11 +186,6 @@ def reason_html(line):
     return f"<code>{esc(line)}</code>" + (f": {esc(what)}" if what else "")
 
 
-def decided_share(case):
-    """The share of a case's conformance frame the ambiguity mask leaves decided."""
-    return 1.0 - case["accuracy"].get("ambiguous", 0.0)
-
-
 def device_text(backend):
     """Where a ranked backend ran: its GPU-backend device (marked when software), or the CPU."""
     d = backend.get("device")
@@ -521,7 +516,8 @@ def regression_section(results):
                          "measured.</p>")
     regressions, improvements = r["regressions"], r["improvements"]
     ok = not regressions
-    source = "the baseline given with --baseline" if r.get("given") else "the committed baseline, as this run was measured alike"
+    source = ("the baseline given with --baseline" if r.get("given")
+              else "the committed baseline, as this run was measured alike")
     out.append(f'<p class="verdict-line">Gate: {verdict_html("pass" if ok else "fail")} '
                f'{r["compared"]} cases compared with {esc(r["baseline"])} ({source}, measured '
                f'{esc(r.get("baseline_created", "?"))}): <b>{len(regressions)} regressions</b>, {len(improvements)} '
@@ -850,8 +846,9 @@ def sweep_section(sweep):
                 check = (f'passes at {esc(k["size"])} on {len(k["scenes"])} scene(s)' if k else
                          "not re-checked")
                 note = "<b>fallback</b>: no stable eps neighbour" if r.get("fallback") else ""
+                rule = r["offset_label"] if r["offset_label"].endswith("xeps") else "fixed"
                 rec_rows.append([t, g["method"], g["precision"], f'{len(g["stable"])}/{len(g["grid"])}',
-                                 f'{r["eps"]:g}', f'{r["offset"]:g} ({r["offset_label"] if r["offset_label"].endswith("xeps") else "fixed"})',
+                                 f'{r["eps"]:g}', f'{r["offset"]:g} ({rule})',
                                  f'{r["time_ms"]:.3g} ms, {pct(r["hit_mismatch"])} hit wrong', check,
                                  f'<td class="{"limit" if note else ""}">{note}</td>'])
                 continue
