@@ -107,13 +107,17 @@ void add_report(CLI::App& app) {
       "(Google Benchmark, median of repetitions) and measured against the oracle (the conformance\n"
       "suite) — sweep eps x offset per surface type, time the scaling series (resolution, edges,\n"
       "path length), and write OUT/results.json (with this machine's fingerprint) and a\n"
-      "self-contained OUT/index.html: gallery images per backend, speed against accuracy,\n"
-      "stability and step heatmaps, failure tables, scaling curves, the ranking of backends and\n"
-      "recommended parameters. The quick default takes a few minutes on 2 cores; --full measures\n"
-      "more. Given result files (RESULTS...), measures nothing: one file makes its page again,\n"
-      "several compare their machines. --baseline checks the deterministic figures (steps,\n"
-      "crossings, conformance rates) against committed ones: exit 1 when one regresses beyond its\n"
-      "tolerance; slower timings only warn.");
+      "self-contained OUT/index.html: the verdicts (pass, limit, fail) with every failed check,\n"
+      "the ranking of backends and recommended parameters, the recommended method's images with\n"
+      "their differences from the oracle, gallery images per backend, speed against accuracy,\n"
+      "the ambiguous share, stability and step heatmaps, scaling curves, definitions. The quick\n"
+      "default takes a few minutes on 2 cores; --full measures more. Given result files\n"
+      "(RESULTS...), measures nothing: one file makes its page again, several compare their\n"
+      "machines. --baseline checks the deterministic figures (steps, crossings, conformance\n"
+      "rates) against committed ones: exit 1 when one regresses beyond its tolerance; slower\n"
+      "timings only warn. Without it the page shows the same check against\n"
+      "reports/baseline.json when this run was measured as it was, else why not. --previous\n"
+      "adds the change per case since an earlier run.");
   struct Options {
     std::vector<std::string> results, backends, scenes, methods;
     std::vector<std::string> galleries = {"scenes"};
