@@ -208,10 +208,12 @@ json recommend(const json& ranking, const json& sweep) {
                  ? "the fastest backend of those that passed every conformance case, with its "
                    "fastest method of those that passed on every scene"
                  : "no backend passed every conformance case (" +
-                       std::to_string((*top)["cases"].get<int>() - (*top)["passed"].get<int>()) +
-                       " of this one's did not pass, " + std::to_string((*top).value("limits", 0)) +
-                       " of them at their method's limit): the fastest backend with a method that "
-                       "passed on every scene, and its fastest such method";
+                       (*top)["backend"].get<std::string>() + ": " +
+                       std::to_string((*top)["passed"].get<int>()) + " of " +
+                       std::to_string((*top)["cases"].get<int>()) + " pass, " +
+                       std::to_string((*top).value("limits", 0)) +
+                       " at their method's limit): the fastest backend with a method that passed "
+                       "on every scene, and its fastest such method";
   const MarchParams defaults;
   json parameters = json::object();
   const json analysis = sweep.value("analysis", json::array());

@@ -281,9 +281,9 @@ TEST(Ranking, ARecommendationWithoutAConformingBackendSaysSo) {
   const json rec = recommend(rank_backends({{"cases", cases}}), json::object());
   EXPECT_EQ(rec["method"], "analytic");
   EXPECT_EQ(rec["why"],
-            "no backend passed every conformance case (1 of this one's did not pass, 1 of them at "
-            "their method's limit): the fastest backend with a method that passed on every scene, "
-            "and its fastest such method");
+            "no backend passed every conformance case (cpu: 3 of 4 pass, 1 at their method's "
+            "limit): the fastest backend with a method that passed on every scene, and its fastest "
+            "such method");
 }
 
 // Where the recommended method has no stable point on a surface type, select falls back to the
