@@ -690,25 +690,34 @@ def failure_section(cases):
     out = ["<h2 id=failures>Failures</h2><p>Per backend and method: the cases of each verdict, and the rays of "
            "each failure class summed over the scenes (decided pixels of the conformance frames and diverging "
            "probe rays; see <a href=\"#definitions\">Definitions</a>). Then each case that did not pass, with "
-           "every check it failed: its measured value against the threshold, and what the check measures.</p>",
+           "every check it failed: its measured value against the threshold, and what the check measures (the "
+           "backends whose cases read alike share a row).</p>",
            table(["backend", "method", "cases", "pass", "limit", "fail or error"] + FAILURES, rows)]
     order = {"fail": 0, "error": 0, "limit": 1}
     bad = sorted((c for c in cases if verdict(c) in order),
                  key=lambda c: (order[verdict(c)], c["scene"], c["method"], c["backend"]))
-    rows = []
+    # Cases whose verdict and reasons read alike (the same scene and method on several backends)
+    # share a row that names each of them.
+    groups = {}
     for c in bad:
         v = verdict(c)
         if v == "error":
-            why = f'<td>{esc(c["error"])}</td>'
+            lines = [esc(c["error"])]
         else:
             a = c["accuracy"]
             lines = [reason_html(line) for line in a.get("failed_checks", [])]
             if v == "limit":
                 lines.insert(0, f'<b>{esc(a.get("limit", ""))}</b>')
-            why = "<td>" + "<br>".join(lines) + "</td>"
-        rows.append([c["name"], f"<td>{verdict_html(v)}</td>", why])
+        groups.setdefault((c["scene"], c["method"], v, tuple(lines)), []).append(c)
+    rows = []
+    for (scene, method, v, lines), group in groups.items():
+        names = " ".join(c["name"] for c in group)
+        rows.append([f'<td data-cases="{esc(names)}">{esc(scene)} &middot; {esc(method)}<br>'
+                     f'<small>{esc(", ".join(c["backend"] for c in group))} ({esc(group[0]["name"].split("/")[-1])})'
+                     "</small></td>", f"<td>{verdict_html(v)}</td>", "<td>" + "<br>".join(lines) + "</td>"])
     if rows:
-        out.append(table(["case", "verdict", "why: each failed check"], rows, "reasons"))
+        out.append(table(["scene · method (backends)", "verdict", "why: each failed check"], rows,
+                         "reasons"))
     else:
         out.append("<p class=good>Every case passed its thresholds.</p>")
     return "\n".join(out)
@@ -752,7 +761,7 @@ def sweep_section(sweep):
               if confirm else "these results, written without a re-check at a larger size, may hold a point "
               "that passes only at this size.") + "</p>" + legend]
     rec_rows = []
-    no_stable = []
+    no_stable = {}  # (surface type, method, why) -> the precisions with no stable point
     types = [t for t in SURFACE_TYPES if any(g["surface_type"] == t for g in analysis)]
     for t in types:
         groups = [g for g in analysis if g["surface_type"] == t]
@@ -864,14 +873,14 @@ def sweep_section(sweep):
             rec_rows.append([t, g["method"], g["precision"], f'0/{len(g["grid"])}', "-", "-",
                              f'<td class="bad">nothing stable{f": mostly {esc(top)}" if top else ""}</td>', "-",
                              f"<td>{advice}</td>"])
-            no_stable.append(f'<b>{esc(g["method"])}</b> ({esc(g["precision"])}) on {esc(t)} surfaces: no point of '
-                             f'the grid passes on every scene{f" (most often: {esc(top)})" if top else ""}; '
-                             + advice)
+            why = f'no point of the grid passes on every scene{f" (most often: {esc(top)})" if top else ""}; ' + advice
+            no_stable.setdefault((t, g["method"], why), []).append(g["precision"])
     out.insert(1, table(["surface type", "method", "precision", "stable points", "eps", "offset", "at",
                          "re-check", "note"], rec_rows))
     if no_stable:
-        out.insert(2, '<p class="bad">Where no point is stable:</p><ul>'
-                   + "".join(f"<li>{x}.</li>" for x in no_stable) + "</ul>")
+        out.insert(2, '<p class="bad">Where no point is stable:</p><ul>' + "".join(
+            f'<li><b>{esc(m)}</b> ({esc(", ".join(precisions))}) on {esc(t)} surfaces: {why}.</li>'
+            for (t, m, why), precisions in no_stable.items()) + "</ul>")
     return "\n".join(out)
 
 

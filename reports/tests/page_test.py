@@ -103,7 +103,7 @@ def main():
         a = c["accuracy"]
         if a["verdict"] == "pass":
             continue
-        row = re.search(rf'<td>{re.escape(c["name"])}</td>(.*?)</tr>', reasons, re.S)
+        row = re.search(rf'<td data-cases="[^"]*\b{re.escape(c["name"])}\b[^"]*">(.*?)</tr>', reasons, re.S)
         expect(row, f"failures: no row for {c['name']}")
         for line in a["failed_checks"] + ([a["limit"]] if a["verdict"] == "limit" else []):
             expect(row and html.escape(line, quote=False) in row.group(1),
