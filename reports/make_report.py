@@ -67,6 +67,12 @@ CHECKS = {
 }
 CHECKS.update({f"failures.{f}": f"decided pixels that {m}, of the decided pixels"
                for f, m in FAILURE_MEANINGS.items() if f != "leak"})
+# Checks named per region of the frame ("colour.object 0", "colour.walls"), by their prefix.
+CHECK_PREFIXES = {
+    "colour.": "% of the region's compared pixels (an object, a vertex marker, the walls, the floor or the sky; "
+               "decided pixels whose ray ended as the oracle's) whose colour differs from the oracle's at that "
+               "pixel and at its neighbours of the region by more than the CIE Delta E tolerance",
+}
 # The short code each cause of an unstable sweep point gets in its heatmap cell.
 CAUSE_CODES = {
     "stuck": "st", "wrong_edge": "we", "missed_object": "mo", "phantom_hit": "ph", "early_escape": "ee",
@@ -182,7 +188,7 @@ def verdict_html(v):
 def reason_html(line):
     """One failed check ("name value < limit") with what the check measures."""
     name = line.split(" ", 1)[0]
-    what = CHECKS.get(name)
+    what = CHECKS.get(name) or next((v for k, v in CHECK_PREFIXES.items() if line.startswith(k)), None)
     return f"<code>{esc(line)}</code>" + (f": {esc(what)}" if what else "")
 
 
@@ -257,6 +263,7 @@ def definitions_section(results, cases):
     prisms = sorted(by_type.get("prism", []))
     failure_rows = [[f, m] for f, m in FAILURE_MEANINGS.items()]
     check_rows = [[f"<td><code>{esc(k)}</code></td>", v] for k, v in CHECKS.items()]
+    check_rows += [[f"<td><code>{esc(k)}REGION</code></td>", v] for k, v in CHECK_PREFIXES.items()]
     return (
         "<h2 id=definitions>Definitions</h2>"
         f"<p><b>Conformance frame</b>: each case renders its scene from the scene's own camera at "
