@@ -27,12 +27,14 @@ std::string quoted(const std::string& word) {
   return q + "'";
 }
 
-// Charts and the page, by reports/make_report.py with matplotlib.
+// Charts and the page, by reports/make_report.py with matplotlib; `previous`: an earlier run's
+// results, compared case by case.
 void make_html(const std::string& python, const std::vector<std::string>& results,
-               const fs::path& out) {
+               const fs::path& out, const std::string& previous) {
   std::string command = quoted(python) + " " +
                         quoted(FLATMARCH_SOURCE_DIR "/reports/make_report.py") + " -o " +
                         quoted(out.string());
+  if (!previous.empty()) command += " --previous " + quoted(previous);
   for (const std::string& r : results) command += " " + quoted(r);
   if (std::system(command.c_str()) != 0)
     throw std::runtime_error(
@@ -59,6 +61,38 @@ struct StageProgress {
   }
 };
 
+// Throws a UsageError unless `file` is a results file of `flatmarch report`.
+void check_results_file(const std::string& option, const std::string& file) {
+  const json doc = read_json(option, file);
+  for (const char* key : {"fingerprint", "matrix", "ranking"})
+    if (!doc.is_object() || !doc.contains(key))
+      throw UsageError(option + ": " + file + " has no \"" + key +
+                       "\": not a results file of `flatmarch report`");
+}
+
+// The regression section's figures: this run checked against `given` (--baseline), else
+// against the committed reports/baseline.json when it was measured alike; else "checked" false
+// and why not.
+json regression(const json& results, const std::string& given) {
+  const std::string file = given.empty() ? FLATMARCH_SOURCE_DIR "/reports/baseline.json" : given;
+  if (given.empty() && !fs::exists(file))
+    return {{"checked", false}, {"why", file + " is not there"}};
+  const json baseline = read_json("--baseline", file);
+  if (const std::string why = reports::baseline_mismatch(baseline, results); !why.empty())
+    return {{"checked", false},
+            {"baseline", file},
+            {"given", !given.empty()},
+            {"why", given.empty() ? why : why + "; measure alike"}};
+  json r = reports::check_baseline(baseline, results);
+  r["checked"] = true;
+  r["baseline"] = file;
+  r["given"] = !given.empty();
+  r["baseline_created"] = baseline.value("created", "");
+  r["baseline_cases"] = baseline["cases"].size();
+  r["tolerances"] = baseline["tolerances"];
+  return r;
+}
+
 std::string default_python() {
   if (const char* p = std::getenv("FLATMARCH_PYTHON")) return p;
   return "/usr/bin/python3";
@@ -73,18 +107,22 @@ void add_report(CLI::App& app) {
       "(Google Benchmark, median of repetitions) and measured against the oracle (the conformance\n"
       "suite) — sweep eps x offset per surface type, time the scaling series (resolution, edges,\n"
       "path length), and write OUT/results.json (with this machine's fingerprint) and a\n"
-      "self-contained OUT/index.html: gallery images per backend, speed against accuracy,\n"
-      "stability and step heatmaps, failure tables, scaling curves, the ranking of backends and\n"
-      "recommended parameters. The quick default takes a few minutes on 2 cores; --full measures\n"
-      "more. Given result files (RESULTS...), measures nothing: one file makes its page again,\n"
-      "several compare their machines. --baseline checks the deterministic figures (steps,\n"
-      "crossings, conformance rates) against committed ones: exit 1 when one regresses beyond its\n"
-      "tolerance; slower timings only warn.");
+      "self-contained OUT/index.html: the verdicts (pass, limit, fail) with every failed check,\n"
+      "the ranking of backends and recommended parameters, the recommended method's images with\n"
+      "their differences from the oracle, gallery images per backend, speed against accuracy,\n"
+      "the ambiguous share, stability and step heatmaps, scaling curves, definitions. The quick\n"
+      "default takes a few minutes on 2 cores; --full measures more. Given result files\n"
+      "(RESULTS...), measures nothing: one file makes its page again, several compare their\n"
+      "machines. --baseline checks the deterministic figures (steps, crossings, conformance\n"
+      "rates) against committed ones: exit 1 when one regresses beyond its tolerance; slower\n"
+      "timings only warn. Without it the page shows the same check against\n"
+      "reports/baseline.json when this run was measured as it was, else why not. --previous\n"
+      "adds the change per case since an earlier run.");
   struct Options {
     std::vector<std::string> results, backends, scenes, methods;
     std::vector<std::string> galleries = {"scenes"};
     std::string out = "reports/out", size, conform_size = "160x90", sweep_size, sweep_backend;
-    std::string baseline, write_baseline, python = default_python();
+    std::string baseline, write_baseline, previous, python = default_python();
     int repetitions = 0;
     double min_time = 0.02;
     bool full = false, no_sweep = false, no_scaling = false, no_html = false, quiet = false;
@@ -121,6 +159,10 @@ void add_report(CLI::App& app) {
   cmd->add_option("--baseline", o->baseline,
                   "Check against this baseline (reports/baseline.json): exit 1 on a regression")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--previous", o->previous,
+                  "An earlier run's results.json: the page shows the change per case (verdicts "
+                  "first, then hit mismatch, ambiguous share and speed)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--write-baseline", o->write_baseline,
                   "Write this run's deterministic figures as a baseline file");
   cmd->add_option("--python", o->python, "python3 with matplotlib (env FLATMARCH_PYTHON)")
@@ -131,17 +173,17 @@ void add_report(CLI::App& app) {
   add_backend_options(*cmd, o->backend_options);
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
+    if (!o->previous.empty()) {
+      check_results_file("--previous", o->previous);
+      if (o->results.size() > 1)
+        throw UsageError("--previous compares one run with an earlier one: give one RESULTS");
+      if (o->no_html) throw UsageError("--previous is shown on the page: drop --no-html");
+    }
     if (!o->results.empty()) {
       if (!o->baseline.empty() || !o->write_baseline.empty())
         throw UsageError("--baseline and --write-baseline measure: give no RESULTS with them");
-      for (const std::string& file : o->results) {
-        const json doc = read_json("RESULTS", file);
-        for (const char* key : {"fingerprint", "matrix", "ranking"})
-          if (!doc.contains(key))
-            throw UsageError("RESULTS: " + file + " has no \"" + key +
-                             "\": not a results file of `flatmarch report`");
-      }
-      make_html(o->python, o->results, o->out);
+      for (const std::string& file : o->results) check_results_file("RESULTS", file);
+      make_html(o->python, o->results, o->out, o->previous);
       std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
       return;
     }
@@ -204,8 +246,9 @@ void add_report(CLI::App& app) {
     }
 
     StageProgress progress{o->quiet, "", nullptr};
-    const json results = reports::run_report(scenes, r, std::ref(progress));
+    json results = reports::run_report(scenes, r, std::ref(progress));
     if (progress.reporter) progress.reporter->done();
+    results["regression"] = regression(results, o->baseline);
     const fs::path file = fs::path(o->out) / "results.json";
     write_json(file, results);
     std::printf("%s", reports::describe_selection(results, "").c_str());
@@ -215,21 +258,17 @@ void add_report(CLI::App& app) {
       std::printf("report: wrote the baseline %s\n", o->write_baseline.c_str());
     }
     if (!o->no_html) {
-      make_html(o->python, {file.string()}, o->out);
+      make_html(o->python, {file.string()}, o->out, o->previous);
       std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
     }
     if (!o->baseline.empty()) {
-      const json baseline = read_json("--baseline", o->baseline);
-      if (baseline.value("format", "") != "flatmarch-baseline/1")
-        throw UsageError("--baseline: " + o->baseline + " is not a baseline file");
-      for (const char* key : {"size", "conform_size", "eps", "offset", "max_steps"})
-        if (baseline["options"][key] != results["options"][key])
-          throw UsageError("--baseline: it was measured with " + std::string(key) + " " +
-                           baseline["options"][key].dump() + ", this run with " +
-                           results["options"][key].dump() + "; measure alike");
-      const json check = reports::check_baseline(baseline, results);
+      const json& check = results["regression"];
+      if (!check["checked"].get<bool>())
+        throw UsageError("--baseline: " + o->baseline + ": " + check["why"].get<std::string>());
       write_json(fs::path(o->out) / "gate.json", check);
-      std::printf("%s", reports::describe_gate(check, baseline, o->baseline).c_str());
+      std::printf(
+          "%s",
+          reports::describe_gate(check, read_json("--baseline", o->baseline), o->baseline).c_str());
       if (!check["regressions"].empty())
         throw ConformanceFailure(std::to_string(check["regressions"].size()) +
                                  " figures regressed against " + o->baseline);

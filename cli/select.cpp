@@ -18,8 +18,9 @@ void add_select(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "select",
       "Print the backend, method and parameters `flatmarch report` chose for this machine, from\n"
-      "its results file: the fastest backend of those that passed every conformance case, its\n"
-      "fastest conforming method, and eps and offset per surface type from the sweep.");
+      "its results file: the fastest backend of those that passed every conformance case (when\n"
+      "none did, the fastest with a method that passed on every scene), its fastest conforming\n"
+      "method, and eps and offset per surface type from the sweep.");
   struct Options {
     std::string results = "reports/out/results.json", scene;
   };

@@ -90,8 +90,9 @@ void add_sweep(CLI::App& app) {
       std::string rec = "-";
       if (!g["recommended"].is_null()) {
         char s[64];
-        std::snprintf(s, sizeof s, "%g / %g", g["recommended"]["eps"].get<double>(),
-                      g["recommended"]["offset"].get<double>());
+        std::snprintf(s, sizeof s, "%g / %g%s", g["recommended"]["eps"].get<double>(),
+                      g["recommended"]["offset"].get<double>(),
+                      g["recommended"]["fallback"].get<bool>() ? " (fallback)" : "");
         rec = s;
       }
       std::string front;

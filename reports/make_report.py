@@ -2,6 +2,8 @@
 """The report's page: charts (matplotlib) and tables from the results files of `flatmarch report`.
 
     make_report.py -o OUT RESULTS.json            one machine: OUT/index.html
+    make_report.py -o OUT --previous OLD.json RESULTS.json
+                                                  the same, with the change per case since OLD
     make_report.py -o OUT A.json B.json ...       machines compared: OUT/index.html
 
 The page is self-contained: charts and gallery images are embedded (PNG, base64). Called by
@@ -30,18 +32,88 @@ BACKEND_COLOURS = {}
 METHOD_MARKERS = {}
 PALETTE = ["#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"]
 MARKERS = ["o", "s", "^", "D", "v", "P"]
-SURFACE_TYPES = ["prism", "mirror", "dilation", "reflection", "rotation", "translation"]
-FAILURES = ["stuck", "wrong_edge", "missed_object", "phantom_hit", "early_escape", "late_escape", "leak"]
+SURFACE_TYPES = []
+# Failure classes (conformance/compare.hpp), in its order, with what each means.
+FAILURE_MEANINGS = {
+    "stuck": "ran out of steps (max_steps) where the oracle's ray ended",
+    "wrong_edge": "crossed another edge than the oracle's ray (at corners), or another number of edges",
+    "missed_object": "the oracle's ray hit an object; this one did not, or hit another",
+    "phantom_hit": "hit an object the oracle's ray did not",
+    "early_escape": "escaped (or ran out of distance) where the oracle's ray met a wall or the floor",
+    "late_escape": "met a wall or the floor where the oracle's ray escaped",
+    "leak": "a push after a crossing landed outside the destination room (probe-ray traces only)",
+}
+FAILURES = list(FAILURE_MEANINGS)
+# The conformance checks (conformance/suite.cpp), each with what it measures and over what.
+CHECKS = {
+    "hit_rate": "decided pixels whose hit (what ended the ray) is the oracle's, of the decided pixels",
+    "crossings_rate": "decided pixels whose number of crossings is the oracle's, of the decided pixels",
+    "ambiguous": "pixels the ambiguity mask leaves undecided, of all the frame's pixels",
+    "t.exceeded": "decided pixels ending as the oracle's whose path length t is off by more than the "
+                  "method's slack, of those compared",
+    "most_steps": "the most steps any ray of the frame took",
+    "image.failpercent": "% of the frame's pixels whose colour differs from the oracle's by more than 0.05 in "
+                         "a channel (undecided pixels left out)",
+    "image.max_error": "the largest difference of a colour channel over the decided pixels",
+    "image.perceptual_failpercent": "% of the frame's pixels Yee's perceptual metric tells apart from the "
+                                    "oracle's (undecided pixels left out)",
+    "steps.ks": "Kolmogorov-Smirnov distance between the frame's step counts and the scalar float64 "
+                "reference's",
+    "steps.mean_ratio": "mean steps against the scalar float64 reference's (the larger of the ratio and its "
+                        "inverse)",
+    "traces.diverged": "probe rays whose list of events differs from the oracle's, a count",
+    "traces.error": "the largest position or t error over the probe rays' agreeing events, over the "
+                    "scene's scale",
+}
+CHECKS.update({f"failures.{f}": f"decided pixels that {m}, of the decided pixels"
+               for f, m in FAILURE_MEANINGS.items() if f != "leak"})
+# Checks named per region of the frame ("colour.object 0", "colour.walls"), by their prefix.
+CHECK_PREFIXES = {
+    "colour.": "% of the region's compared pixels (an object, a vertex marker, the walls, the floor or the sky; "
+               "decided pixels whose ray ended as the oracle's) whose colour differs from the oracle's at that "
+               "pixel and at its neighbours of the region by more than the CIE Delta E tolerance",
+}
+# The short code each cause of an unstable sweep point gets in its heatmap cell.
+CAUSE_CODES = {
+    "stuck": "st", "wrong_edge": "we", "missed_object": "mo", "phantom_hit": "ph", "early_escape": "ee",
+    "late_escape": "le", "leak": "lk", "hit_rate": "hr", "crossings_rate": "cr", "ambiguous": "am",
+    "t.exceeded": "t", "most_steps": "ms", "image.failpercent": "im", "image.max_error": "mx",
+    "image.perceptual_failpercent": "pe", "steps.ks": "ks", "steps.mean_ratio": "sr",
+    "traces.diverged": "tr", "traces.error": "te", "error": "err",
+    "confirmation": "rc",
+}
+CAUSE_MEANINGS = dict(FAILURE_MEANINGS, **CHECKS, error="the backend failed to render",
+                      confirmation="passes at the sweep's size but fails its re-check at the larger size")
+# Issue 22's goals for the ambiguous share at default parameters, per method, in prisms and elsewhere
+# (None: no goal).
+AMBIGUITY_GOALS = {"analytic": {"prism": 0.05, "other": 0.05},
+                   "sphere": {"prism": None, "other": 0.12}, "relaxed": {"prism": None, "other": 0.12}}
+# A case's verdict (conformance/suite.hpp), and what it means.
+VERDICTS = {
+    "pass": "every check within its threshold",
+    "limit": "fails the thresholds only through a documented failure mode of its method (rays out of "
+             "max_steps, offset <= eps), by no more than that mode accounts for: never counted as a pass; "
+             "ctest expects it and the regression gate holds it from getting worse",
+    "fail": "beyond a threshold in any other way",
+    "error": "the backend could not render or time the case",
+}
 
 
 def use_registry(all_results):
-    """Takes the backend and method lists from the results (the first that carries them; results
-    written before they did: the backends and methods their cases name, in order of appearance)."""
-    backends, methods = [], []
+    """Takes the backend, method and surface type lists from the results (the first that carries
+    them; results written before they did: the backends and methods their cases name, in order of
+    appearance, and the surface types of their cases and sweep)."""
+    backends, methods, types = [], [], []
     for r in all_results:
         if "registry" in r:
             backends, methods = r["registry"]["backends"], r["registry"]["methods"]
+            types = r["registry"].get("surface_types", [])
             break
+    if not types:
+        for r in all_results:
+            for c in r.get("matrix", {}).get("cases", []) + r.get("sweep", {}).get("analysis", []):
+                if c["surface_type"] not in types:
+                    types.append(c["surface_type"])
     if not backends:
         for r in all_results:
             for c in r.get("matrix", {}).get("cases", []):
@@ -50,6 +122,7 @@ def use_registry(all_results):
                 if c["method"] not in methods:
                     methods.append(c["method"])
     METHODS[:] = methods
+    SURFACE_TYPES[:] = types
     BACKEND_COLOURS.clear()
     BACKEND_COLOURS.update({b: PALETTE[k % len(PALETTE)] for k, b in enumerate(backends)})
     METHOD_MARKERS.clear()
@@ -97,6 +170,28 @@ def pct(share):
     return f"{100 * share:.3g}%"
 
 
+def verdict(case):
+    """A case's verdict: pass, limit, fail, or error (results written before verdicts: pass or
+    fail by its checks); None for a case not measured against the oracle."""
+    if "error" in case:
+        return "error"
+    a = case.get("accuracy")
+    if not a:
+        return None
+    return a.get("verdict", "pass" if a["passed"] else "fail")
+
+
+def verdict_html(v):
+    return f'<span class="verdict {esc(v)}">{esc(v)}</span>'
+
+
+def reason_html(line):
+    """One failed check ("name value < limit") with what the check measures."""
+    name = line.split(" ", 1)[0]
+    what = CHECKS.get(name) or next((v for k, v in CHECK_PREFIXES.items() if line.startswith(k)), None)
+    return f"<code>{esc(line)}</code>" + (f": {esc(what)}" if what else "")
+
+
 def device_text(backend):
     """Where a ranked backend ran: its GPU-backend device (marked when software), or the CPU."""
     d = backend.get("device")
@@ -129,6 +224,124 @@ def fingerprint_rows(fp):
 # --- One machine.
 
 
+def summary_section(results, cases):
+    """The verdicts counted apart, overall and per backend and method."""
+    counts = {v: 0 for v in VERDICTS}
+    per = {}
+    for c in cases:
+        v = verdict(c)
+        if v is None:
+            continue
+        counts[v] += 1
+        per.setdefault(c["backend"], {}).setdefault(c["method"], {k: 0 for k in VERDICTS})[v] += 1
+    judged = sum(counts.values())
+    boxes = "".join(f'<div class="count {v}"><b>{counts[v]}</b> {v}</div>' for v in VERDICTS
+                    if v != "error" or counts[v])
+    rows = []
+    for b, methods in per.items():
+        row = [b]
+        for m in METHODS:
+            n = methods.get(m)
+            row.append(td(" · ".join(f"{n[v]} {v}" for v in VERDICTS if n[v] or v != "error") if n else "-",
+                          "bad" if n and (n["fail"] or n["error"]) else "limit" if n and n["limit"] else ""))
+        rows.append(row)
+    return (f'<h2 id=summary>Verdicts</h2><div class="counts">{boxes}</div>'
+            f'<p>{judged} cases (backend &times; method &times; scene), each measured against the oracle at '
+            f'{esc(results["options"]["conform_size"])} with one set of thresholds. '
+            + "; ".join(f"<b>{v}</b>: {esc(m)}" for v, m in VERDICTS.items())
+            + '. Each case that did not pass is listed with the checks it failed and why in '
+              '<a href="#failures">Failures</a>; the terms are defined in <a href="#definitions">Definitions</a>.</p>'
+            + table(["backend"] + METHODS, rows))
+
+
+def definitions_section(results, cases):
+    scenes = results["options"]["scenes"]
+    w, h = (int(v) for v in results["options"]["conform_size"].split("x"))
+    by_type = {}
+    for c in cases:
+        by_type.setdefault(c["surface_type"], set()).add(c["scene"])
+    prisms = sorted(by_type.get("prism", []))
+    failure_rows = [[f, m] for f, m in FAILURE_MEANINGS.items()]
+    check_rows = [[f"<td><code>{esc(k)}</code></td>", v] for k, v in CHECKS.items()]
+    check_rows += [[f"<td><code>{esc(k)}REGION</code></td>", v] for k, v in CHECK_PREFIXES.items()]
+    return (
+        "<h2 id=definitions>Definitions</h2>"
+        f"<p><b>Conformance frame</b>: each case renders its scene from the scene's own camera at "
+        f"{w}&times;{h} = {w * h} pixels, with the method's parameters; the oracle renders the same frame "
+        f"exactly. The scenes: {esc(', '.join(scenes))}.</p>"
+        "<p><b>Ambiguity mask, decided pixels</b>: a marching kernel does not follow the exact ray: sphere "
+        "tracing stops within eps of an edge and pushes the point offset into the next room, and every method "
+        "rounds. The mask (conformance/ambiguity.hpp) marks a pixel <i>undecided</i> when its exact ray passes "
+        "within that drift of a vertex or of an edge it does not cross, meets an edge near the top or bottom "
+        "of the wall band, grazes an object's silhouette or crease, or ends near max_distance: there either "
+        "answer is right. The rest are the <b>decided pixels</b>. The mask depends on the scene, the method "
+        "(its push) and the precision, not on the backend.</p>"
+        f"<p><b>Ambiguous share</b> = undecided pixels / all {w * h} pixels of a case's conformance frame, per "
+        "scene and method (table in <a href=\"#ambiguity\">Ambiguity</a>). In translation prisms "
+        f"({esc(', '.join(prisms)) or 'none in this run'}) rays run long and cross many edges, so the share is "
+        "largest there: a case is then judged on a part of its frame only.</p>"
+        "<p><b>Hit wrong</b> (the charts' error axis) = 1 - hit_rate: decided pixels whose hit differs from "
+        "the oracle's / decided pixels of the case's conformance frame.</p>"
+        "<p><b>Failure classes</b>: how a ray that disagrees with the oracle's went wrong "
+        "(conformance/compare.hpp). Counted over (1) the decided pixels of each case's conformance frame "
+        "whose hit or crossings differ from the oracle's: each such pixel is one ray of one class, and the "
+        "check <code>failures.CLASS</code> is their number / the decided pixels; and (2) the suite's probe "
+        "rays (nearly horizontal rays from random points, kept only when their exact path stays clear of "
+        "every vertex), one for each whose events diverge from the oracle's. The Failures table sums both "
+        "over the scenes of this run, per backend and method.</p>"
+        + table(["failure class", "the ray"], failure_rows)
+        + "<p><b>Checks</b>: a case passes when each is within its threshold "
+          "(conformance/thresholds.json). A failed check is shown as <code>name value &lt; limit</code> "
+          "(at least) or <code>name value &gt; limit</code> (at most).</p>"
+        + table(["check", "measures"], check_rows))
+
+
+def ambiguity_section(cases):
+    """The ambiguous share per scene and method, from the first backend (in the registry's order)
+    that measured the pair; a backend that found another share is named in the cell."""
+    shares = {}
+    for c in cases:
+        if "accuracy" in c and "ambiguous" in c["accuracy"]:
+            shares.setdefault((c["scene"], c["method"]), []).append((c["backend"], c["accuracy"]["ambiguous"]))
+    if not shares:
+        return ""
+    order = list(BACKEND_COLOURS)
+    scenes = []
+    for c in cases:
+        if c["scene"] not in scenes:
+            scenes.append(c["scene"])
+    types = {c["scene"]: c["surface_type"] for c in cases}
+    methods = [m for m in METHODS if any(k[1] == m for k in shares)]
+    first_backends = set()
+    rows = []
+    for s in scenes:
+        row = [s, types[s]]
+        for m in methods:
+            got = sorted(shares.get((s, m), []), key=lambda bv: order.index(bv[0]) if bv[0] in order else len(order))
+            if not got:
+                row.append("-")
+                continue
+            first_backends.add(got[0][0])
+            others = [f"{b} {pct(v)}" for b, v in got[1:] if abs(v - got[0][1]) > 1e-9]
+            goal = AMBIGUITY_GOALS.get(m, {}).get("prism" if types[s] == "prism" else "other")
+            cls = "warn" if goal is not None and got[0][1] > goal else ""
+            row.append(td(pct(got[0][1]) + (f" (other: {', '.join(others)})" if others else ""), cls))
+        rows.append(row)
+    means = ["mean over these scenes", ""]
+    for m in methods:
+        v = [sorted(shares[(s, m)], key=lambda bv: order.index(bv[0]) if bv[0] in order else len(order))[0][1]
+             for s in scenes if (s, m) in shares]
+        means.append(pct(sum(v) / len(v)) if v else "-")
+    rows.append(means)
+    return ("<h2 id=ambiguity>Ambiguity: the share of each frame left undecided</h2>"
+            f"<p>Undecided pixels / all pixels of the conformance frame, per scene and method, as the "
+            f"{esc(', '.join(sorted(first_backends)))} backend measured it (the first backend that measured the "
+            "pair; a backend whose share differs is named in the cell: the mask depends on the method and the "
+            "precision, not the backend). Shaded: above issue 22's goal for the method, at most 5% for the "
+            "analytic method on every scene and 12% for sphere and relaxed tracing outside prisms.</p>"
+            + table(["scene", "surface type"] + methods, rows))
+
+
 def ranking_section(results):
     rec = results.get("recommendation", {})
     parts = ["<h2 id=ranking>Ranking on this machine and recommended parameters</h2>"]
@@ -140,8 +353,20 @@ def ranking_section(results):
                         if rec["method"] == "analytic" else "") + "</p>")
         rows = []
         for t, p in rec.get("parameters", {}).items():
-            src = "the sweep's recommendation" if p["source"] == "sweep" else "defaults: the sweep found no stable point"
-            rows.append((t, f'{p["eps"]:g}', f'{p["offset"]:g}', src))
+            if p["source"] == "sweep":
+                src = "the sweep's recommendation" + (", re-checked at " + p["confirmed"]["size"]
+                                                      if p.get("confirmed") else "")
+                if p.get("fallback"):
+                    src = "<b>fallback</b>: " + src + ", a stable point none of whose eps neighbours is stable"
+            else:
+                src = (f'<b>fallback</b>, the defaults: no point of the sweep passes with {esc(rec["method"])} on '
+                       f'every {esc(t)} scene')
+                stable = p.get("stable_methods", [])
+                src += ("; stable there, use instead: " + ", ".join(
+                    f'<b>{esc(m["method"])}</b> (eps {m["eps"]:g}, offset {m["offset"]:g})' for m in stable)
+                        if stable else "; no method is stable there")
+            rows.append((t, f'{p["eps"]:g}', f'{p["offset"]:g}',
+                         f'<td class="{"limit" if p.get("fallback") else ""}">{src}</td>'))
         parts.append(table(["surface type", "eps", "offset", "from"], rows))
     else:
         parts.append(f'<p class="bad">No recommendation: {esc(rec.get("why", ""))}</p>')
@@ -149,19 +374,22 @@ def ranking_section(results):
     rows = []
     for b in results.get("ranking", []):
         row = [b["rank"], b["backend"], device_text(b), mrays(b["rays_per_s"]),
-               f'{b["passed"]}/{b["cases"]}' + (f' ({b["errors"]} errors)' if b["errors"] else "")]
+               f'{b["passed"]}/{b["cases"]} pass' + (f', {b["limits"]} limit' if b.get("limits") else "")
+               + (f', {b["errors"]} errors' if b["errors"] else "")]
         for m in methods:
             mm = b["methods"].get(m)
             peak = f', {pct(mm["of_peak"])} of peak' if mm and "of_peak" in mm else ""
-            row.append(f'{mrays(mm["rays_per_s"])} ({int(mm["passed"])}/{int(mm["cases"])}{peak})' if mm else "-")
+            row.append(f'{mrays(mm["rays_per_s"])} ({int(mm["passed"])}/{int(mm["cases"])} pass{peak})'
+                       if mm else "-")
         row.append(b["best_method"] or "-")
         rows.append(row)
     parts.append("<p>Backends ranked: those that passed every conformance case first, then by the geometric "
-                 "mean of rays per second over every scene and method. Per method: Mrays/s (cases passed; for the "
+                 "mean of rays per second over every scene and method; a case at its method's limit is no pass. "
+                 "Per method: Mrays/s (cases passed; for the "
                  "SIMD backend, the geometric mean of how much of this CPU's peak its frames reach, see Steps). "
                  "A GPU backend names the device it ran on; <i>software</i> marks a rasteriser running on the "
                  "CPU (Mesa's llvmpipe and lavapipe), whose speed says nothing of a GPU's.</p>")
-    parts.append(table(["rank", "backend", "device", "Mrays/s", "conform"] + [f"{m} Mrays/s" for m in methods] +
+    parts.append(table(["rank", "backend", "device", "Mrays/s", "verdicts"] + [f"{m} Mrays/s" for m in methods] +
                        ["fastest conforming method"], rows))
     skipped = results.get("matrix", {}).get("skipped", [])
     if skipped:
@@ -184,10 +412,15 @@ def speed_accuracy_section(cases):
                 continue
             a = c["accuracy"]
             y = 100 * (a["hit_mismatch"] + a["crossings_mismatch"]) / 2
+            v = verdict(c)
+            colour = BACKEND_COLOURS.get(c["backend"], "k")
             ax.scatter(c["counters"]["rays_per_s"] / 1e6, max(y, 1e-3), s=36,
                        marker=METHOD_MARKERS.get(c["method"], "o"),
-                       facecolors=BACKEND_COLOURS.get(c["backend"], "k") if a["passed"] else "none",
-                       edgecolors=BACKEND_COLOURS.get(c["backend"], "k"), linewidths=1.3)
+                       facecolors=colour if v == "pass" else "none", edgecolors=colour, linewidths=1.3,
+                       linestyle="-" if v != "limit" else (0, (1.5, 1)))
+            if v == "fail":
+                ax.scatter(c["counters"]["rays_per_s"] / 1e6, max(y, 1e-3), s=36, marker="x", color=colour,
+                           linewidths=1.0)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_ylim(5e-4, 100)
@@ -198,28 +431,204 @@ def speed_accuracy_section(cases):
         ax.axhline(1e-3, color="grey", lw=0.5)
     handles = [plt.Line2D([], [], color=col, marker="o", ls="", label=b) for b, col in BACKEND_COLOURS.items()]
     handles += [plt.Line2D([], [], color="k", marker=mk, ls="", label=m) for m, mk in METHOD_MARKERS.items()]
-    handles += [plt.Line2D([], [], color="k", marker="o", mfc="none", ls="", label="failed conformance")]
-    fig.legend(handles=handles, loc="lower center", ncol=8, bbox_to_anchor=(0.5, -0.04))
+    handles += [plt.Line2D([], [], color="k", marker="o", mfc="none", ls="", label="limit (hollow)"),
+                plt.Line2D([], [], color="k", marker="x", ls="", label="fail (crossed)")]
+    fig.legend(handles=handles, loc="upper center", ncol=8, bbox_to_anchor=(0.5, 0.0))
     fig.tight_layout()
     return ("<h2 id=speed>Speed against accuracy, per surface type</h2>"
             "<p>Each point is one backend, method and gallery scene: its speed (timed frames) against the share "
             "of pixels the oracle decides whose hit or crossing count is wrong (mean of the two; zero is drawn "
-            "on the bottom line). Hollow: the case failed a conformance threshold. Up and to the left is worse.</p>"
+            "on the bottom line). Filled: the case passes; hollow: at its method's limit; hollow and crossed: it "
+            "fails. Up and to the left is worse.</p>"
             + figure_html(fig, "speed against accuracy"))
 
 
 def gallery_section(results, images):
     scenes = results["options"]["scenes"]
     backends = ["oracle"] + [b["backend"] for b in results.get("ranking", [])]
+    cases = results.get("matrix", {}).get("cases", [])
+    # The matrix keeps the frames of the first method it measured.
+    method = cases[0]["method"] if cases else "?"
+    verdicts = {(c["backend"], c["scene"]): verdict(c) for c in cases if c["method"] == method}
     rows = []
     for s in scenes:
-        rows.append([f"<td>{esc(s)}</td>"] + [
-            "<td>" + image_html(os.path.join(images, b, s + ".png"), f"{s}, {b}") + "</td>" for b in backends])
+        cells = [f"<td>{esc(s)}</td>"]
+        for b in backends:
+            v = verdicts.get((b, s))
+            cells.append("<td>" + image_html(os.path.join(images, b, s + ".png"), f"{s}, {b}")
+                         + (f"<br>{verdict_html(v)}" if v else "") + "</td>")
+        rows.append(cells)
     return ("<h2 id=gallery>Gallery, per backend</h2><p>Each scene from its own camera, by the exact oracle "
-            f"and by each backend (sphere method, {esc(results['options']['size'])}, the timed frames). In the "
-            "translation prisms sphere tracing runs out of steps on many rays (the grey haze), which the "
-            "thresholds allow there; the analytic method does not (see the speed chart above).</p>"
+            f"and by each backend with the {esc(method)} method ({esc(results['options']['size'])}, the timed "
+            "frames), with each case's verdict. A ray that runs out of steps is shaded as fog (the grey haze "
+            "sphere tracing leaves in translation prisms): such a case is at its method's limit, not a pass. "
+            "The recommended method's images, with their differences from the oracle, are in "
+            "<a href=\"#recommended\">the recommended choice</a>.</p>"
             + table(["scene"] + backends, rows, "gallery"))
+
+
+def recommended_gallery_section(results, images):
+    g = results.get("gallery")
+    if not g:
+        why = ("no backend passed every case of any method here, so nothing is recommended"
+               if not results.get("recommendation", {}).get("backend") else "these results have no gallery")
+        return f"<h2 id=recommended>The recommended choice, scene by scene</h2><p>No images: {esc(why)}.</p>"
+    legend = "<ul class=legend>" + "".join(
+        f'<li><span class="swatch" style="background:{esc(e["colour"])}"></span><b>{esc(e["class"])}</b>: '
+        f'{esc(e["meaning"])}</li>' for e in g["legend"] if e["class"] != "agree") + "</ul>"
+    rows = []
+    for sc in g["scenes"]:
+        oracle = image_html(os.path.join(images, "oracle", sc["scene"] + ".png"), f'{sc["scene"]}, oracle')
+        if "error" in sc:
+            rows.append([sc["scene"], f"<td>{oracle}</td>", f'<td class="bad">{esc(sc["error"])}</td>', "-", "-"])
+            continue
+        counts = sc["counts"]
+        pixels = sc["pixels"]
+        decided = pixels - counts.get("ambiguous", 0)
+        differ = [f'{esc(k)} {pct(n / pixels)}' for k, n in counts.items() if n and k not in ("agree",)]
+        wrong = decided - counts.get("agree", 0)
+        rows.append([sc["scene"], f"<td>{oracle}</td>",
+                     "<td>" + image_html(os.path.join(images, sc["image"]),
+                                         f'{sc["scene"]}, {g["backend"]} {g["method"]}') + "</td>",
+                     "<td>" + image_html(os.path.join(images, sc["diff"]), f'{sc["scene"]}, difference') + "</td>",
+                     f'<td>eps {sc["eps"]:g}, offset {sc["offset"]:g}<br>'
+                     f'{pct(wrong / decided) if decided else "-"} of the decided pixels differ<br>'
+                     f'<small>{"; ".join(differ) or "no pixel differs"} (of all {pixels})</small></td>'])
+    return ("<h2 id=recommended>The recommended choice, scene by scene</h2>"
+            f'<p>Each scene rendered by the recommended <b>{esc(g["backend"])}</b> backend with the '
+            f'<b>{esc(g["method"])}</b> method ({esc(g["size"])}) at the eps and offset recommended for its surface '
+            "type, beside the oracle's image and a map of where the two differ. In the map, pixels that agree "
+            "show the oracle's image dimmed; a ray whose hit or crossings differ from the oracle's is painted by "
+            "its failure class, one whose hit and crossings agree but whose colour differs in yellow, and a pixel "
+            "the ambiguity mask leaves undecided in blue:</p>" + legend
+            + table(["scene", "oracle", f'{g["backend"]}, {g["method"]}', "difference", "parameters and pixels"],
+                    rows, "gallery recommended"))
+
+
+def number(v):
+    return f"{v:.4g}" if isinstance(v, float) else esc(v)
+
+
+def regression_section(results):
+    """The regression gate's verdict on this run's figures (results["regression"], written by
+    `flatmarch report`)."""
+    r = results.get("regression")
+    out = ["<h2 id=regression>Regression gate</h2>"]
+    if not r:
+        return out[0] + "<p>Not checked: these results were written before the report stored the gate's verdict.</p>"
+    if not r["checked"]:
+        against = f' against {esc(r["baseline"])}' if r.get("baseline") else ""
+        return out[0] + (f'<p class="verdict-line">Not checked{against}: {esc(r["why"])}. The gate compares only '
+                         "runs measured alike: <code>reports/gate.sh</code> measures as the committed baseline was "
+                         "measured.</p>")
+    regressions, improvements = r["regressions"], r["improvements"]
+    ok = not regressions
+    source = ("the baseline given with --baseline" if r.get("given")
+              else "the committed baseline, as this run was measured alike")
+    out.append(f'<p class="verdict-line">Gate: {verdict_html("pass" if ok else "fail")} '
+               f'{r["compared"]} cases compared with {esc(r["baseline"])} ({source}, measured '
+               f'{esc(r.get("baseline_created", "?"))}): <b>{len(regressions)} regressions</b>, {len(improvements)} '
+               f'improvements, {len(r["timing_warnings"])} timing warnings, {len(r["missing"])} of the baseline\'s '
+               f'{r.get("baseline_cases", "?")} cases not measured in this run.</p>')
+    tol = r.get("tolerances", {})
+    out.append("<p>A deterministic figure (steps, crossings, conformance rates) regresses when it is worse than the "
+               "baseline's by more than its tolerance, abs + rel &times; the baseline's value; a case that passed "
+               "and no longer does, or that was at its method's limit and now fails, regresses too. Timings "
+               "only warn (Mann-Whitney U over the repetitions, p &lt; 0.05, median slower by more than 10%). "
+               "Tolerances: " + ", ".join(f'{esc(k)} {v["abs"]:g} + {v["rel"]:g}&times;' for k, v in tol.items())
+               + ".</p>")
+
+    def rows_of(entries):
+        rows = []
+        for g in entries:
+            was, now = g["was"], g["now"]
+            change = f"{now - was:+.4g}" if isinstance(was, (int, float)) and isinstance(now, (int, float)) \
+                and not isinstance(was, bool) else "-"
+            extra = "<br>".join(reason_html(x) for x in g.get("failed_checks", []))
+            rows.append([g["case"], g["figure"], number(was), number(now), change,
+                         number(g["tolerance"]) if "tolerance" in g else "-", f"<td>{extra}</td>"])
+        return rows
+    header = ["case", "figure", "baseline", "now", "change", "tolerance", "failed checks now"]
+    if regressions:
+        out.append("<h3>Regressions</h3>" + table(header, rows_of(regressions), "regressions"))
+    if improvements:
+        out.append(f"<details><summary>{len(improvements)} improvements beyond tolerance (update the baseline on "
+                   "purpose: <code>reports/gate.sh --write</code>)</summary>" + table(header, rows_of(improvements))
+                   + "</details>")
+    if r["timing_warnings"]:
+        out.append(f'<details><summary>{len(r["timing_warnings"])} cases slower than the baseline (informative: '
+                   "a busy machine slows every case)</summary>" + table(
+                       ["case", "baseline ms", "now ms", "ratio", "p"],
+                       [[w["case"], f'{w["was_ms"]:.3g}', f'{w["now_ms"]:.3g}', f'{w["ratio"]:.2f}',
+                         f'{w["p_value"]:.2g}'] for w in r["timing_warnings"]]) + "</details>")
+        if not r.get("same_machine", True):
+            out.append("<p>The baseline's timings come from another CPU: compare them with care.</p>")
+    return "\n".join(out)
+
+
+def previous_section(results, previous, previous_path):
+    """The change per case since an earlier run: verdict changes first, then the figures."""
+    if previous is None:
+        return ""
+    # Cases by backend, method and scene: the case name also carries the timed frame size.
+    def key(c):
+        return c["backend"], c["method"], c["scene"]
+    now = {key(c): c for c in results.get("matrix", {}).get("cases", [])}
+    was = {key(c): c for c in previous.get("matrix", {}).get("cases", [])}
+    common = [k for k in now if k in was]
+    sizes = [(r.get("options", {}).get("size"), r.get("options", {}).get("conform_size")) for r in (previous, results)]
+    out = [f"<h2 id=previous>Since the earlier run</h2><p>Compared with {esc(previous_path)} (measured "
+           f"{esc(previous.get('created', '?'))}): {len(common)} cases (backend, method, scene) in both, "
+           f"{len(now) - len(common)} new, {len(was) - len(common)} no longer measured."
+           + (f" The earlier run timed frames of {esc(sizes[0][0])} and judged {esc(sizes[0][1])}, this one "
+              f"{esc(sizes[1][0])} and {esc(sizes[1][1])}: compare with care." if sizes[0] != sizes[1] else "")
+           + "</p>"]
+    rank = {"pass": 0, "limit": 1, "fail": 2, "error": 3, None: -1}
+    changed = [(n, verdict(was[n]), verdict(now[n])) for n in common if verdict(was[n]) != verdict(now[n])]
+    changed.sort(key=lambda x: (rank[x[1]] >= rank[x[2]], x[0]))  # worse first
+    if changed:
+        rows = []
+        for n, before, after in changed:
+            a = now[n].get("accuracy", {})
+            why = "<br>".join(reason_html(x) for x in a.get("failed_checks", [])) or esc(now[n].get("error", ""))
+            rows.append([now[n]["name"], f"<td>{verdict_html(before or 'not judged')}</td>",
+                         f"<td>{verdict_html(after or 'not judged')}</td>",
+                         "worse" if rank[after] > rank[before] else "better", f"<td>{why}</td>"])
+        out.append("<h3>Verdicts that changed</h3>" +
+                   table(["case", "before", "now", "", "failed checks now"], rows, "reasons"))
+    else:
+        out.append("<p>No verdict changed.</p>")
+    same_cpu = previous.get("fingerprint", {}).get("cpu") == results.get("fingerprint", {}).get("cpu")
+    rows = []
+    for n in common:
+        a, b = was[n].get("accuracy"), now[n].get("accuracy")
+        d_hit = d_amb = None
+        if a and b:
+            d_hit = b["hit_mismatch"] - a["hit_mismatch"]
+            d_amb = b.get("ambiguous", 0.0) - a.get("ambiguous", 0.0)
+        ra, rb = was[n].get("counters", {}).get("rays_per_s"), now[n].get("counters", {}).get("rays_per_s")
+        speed = rb / ra if ra and rb else None
+        if (d_hit is not None and abs(d_hit) > 1e-4) or (d_amb is not None and abs(d_amb) > 1e-4) or \
+                (speed is not None and not 0.9 <= speed <= 1.1):
+            rows.append((n, d_hit, d_amb, speed))
+    rows.sort(key=lambda x: (-abs(x[1] or 0), -abs(x[2] or 0), -abs(math.log(x[3])) if x[3] else 0))
+
+    def delta(v):
+        if v is None:
+            return "-"
+        if abs(v) < 5e-6:
+            return "0"
+        return td(f"{100 * v:+.3g} pp", "bad" if v > 1e-4 else "good" if v < -1e-4 else "")
+    out.append("<h3>Figures that changed</h3><p>Per case in both runs, where the share of decided pixels whose hit "
+               "is wrong or the ambiguous share moved by more than 0.01 percentage points, or the speed by more "
+               "than 10%: largest hit change first. Speed is this run's rays per second over the earlier run's"
+               + ("" if same_cpu else ", measured on another CPU: compare with care") + ".</p>")
+    if rows:
+        out.append(table(["case", "hit wrong", "ambiguous", "speed"],
+                         [[now[n]["name"], delta(h), delta(a), f"{s:.3g}x" if s else "-"] for n, h, a, s in rows]))
+    else:
+        out.append("<p>No figure moved beyond these bounds.</p>")
+    return "\n".join(out)
 
 
 def steps_heatmap_section(cases):
@@ -273,44 +682,50 @@ def failure_section(cases):
     totals = {}
     for c in cases:
         key = (c["backend"], c["method"])
-        t = totals.setdefault(key, {f: 0 for f in FAILURES} | {"cases": 0, "failed": 0, "limits": 0, "errors": 0})
+        t = totals.setdefault(key, {f: 0 for f in FAILURES} | {v: 0 for v in VERDICTS} | {"cases": 0})
         t["cases"] += 1
-        if "error" in c:
-            t["errors"] += 1
+        v = verdict(c)
+        if v is None:
             continue
-        a = c.get("accuracy")
-        if not a:
-            continue
-        verdict = a.get("verdict", "pass" if a["passed"] else "fail")
-        t["failed"] += verdict == "fail"
-        t["limits"] += verdict == "limit"
+        t[v] += 1
         for f in FAILURES:
-            t[f] += a["failures"].get(f, 0)
+            t[f] += c.get("accuracy", {}).get("failures", {}).get(f, 0)
     for (b, m), t in sorted(totals.items()):
-        rows.append([b, m, f'{t["cases"] - t["failed"] - t["limits"] - t["errors"]}/{t["cases"]}',
-                     td(t["limits"], "bad" if t["limits"] else "")] +
+        rows.append([b, m, t["cases"], t["pass"], td(t["limit"], "limit" if t["limit"] else ""),
+                     td(t["fail"] + t["error"], "bad" if t["fail"] + t["error"] else "")] +
                     [td(t[f], "bad" if t[f] else "") for f in FAILURES])
-    out = ["<h2 id=failures>Failures</h2><p>Rays of each failure class over the gallery (decided pixels of the "
-           "conformance frames and diverging probe rays), per backend and method, and each case that failed "
-           "a threshold, with the checks it failed.</p>",
-           table(["backend", "method", "cases passed", "at the method's limit"] + FAILURES, rows)]
-
-    def verdict(c):
-        a = c.get("accuracy", {})
-        return a.get("verdict", "pass" if a.get("passed", True) else "fail")
-    failed = [c for c in cases if "error" in c or verdict(c) == "fail"]
-    limits = [c for c in cases if "error" not in c and verdict(c) == "limit"]
-    passed = len(cases) - len(failed) - len(limits)
-    out.append(f"<p>{passed} cases pass, {len(limits)} are at their method's limit (they fail the "
-               "thresholds only through a documented failure mode of the method, such as rays running out "
-               f"of max_steps: never counted as a pass), {len(failed)} fail.</p>")
-    if failed:
-        out.append(table(["case", "failed checks"], [
-            [c["name"], c.get("error") or "; ".join(c["accuracy"]["failed_checks"])] for c in failed]))
-    if limits:
-        out.append(table(["case at its method's limit", "why", "checks beyond the thresholds"], [
-            [c["name"], c["accuracy"]["limit"], "; ".join(c["accuracy"]["failed_checks"])] for c in limits]))
-    if not failed and not limits:
+    out = ["<h2 id=failures>Failures</h2><p>Per backend and method: the cases of each verdict, and the rays of "
+           "each failure class summed over the scenes (decided pixels of the conformance frames and diverging "
+           "probe rays; see <a href=\"#definitions\">Definitions</a>). Then each case that did not pass, with "
+           "every check it failed: its measured value against the threshold, and what the check measures (the "
+           "backends whose cases read alike share a row).</p>",
+           table(["backend", "method", "cases", "pass", "limit", "fail or error"] + FAILURES, rows)]
+    order = {"fail": 0, "error": 0, "limit": 1}
+    bad = sorted((c for c in cases if verdict(c) in order),
+                 key=lambda c: (order[verdict(c)], c["scene"], c["method"], c["backend"]))
+    # Cases whose verdict and reasons read alike (the same scene and method on several backends)
+    # share a row that names each of them.
+    groups = {}
+    for c in bad:
+        v = verdict(c)
+        if v == "error":
+            lines = [esc(c["error"])]
+        else:
+            a = c["accuracy"]
+            lines = [reason_html(line) for line in a.get("failed_checks", [])]
+            if v == "limit":
+                lines.insert(0, f'<b>{esc(a.get("limit", ""))}</b>')
+        groups.setdefault((c["scene"], c["method"], v, tuple(lines)), []).append(c)
+    rows = []
+    for (scene, method, v, lines), group in groups.items():
+        names = " ".join(c["name"] for c in group)
+        rows.append([f'<td data-cases="{esc(names)}">{esc(scene)} &middot; {esc(method)}<br>'
+                     f'<small>{esc(", ".join(c["backend"] for c in group))} ({esc(group[0]["name"].split("/")[-1])})'
+                     "</small></td>", f"<td>{verdict_html(v)}</td>", "<td>" + "<br>".join(lines) + "</td>"])
+    if rows:
+        out.append(table(["scene · method (backends)", "verdict", "why: each failed check"], rows,
+                         "reasons"))
+    else:
         out.append("<p class=good>Every case passed its thresholds.</p>")
     return "\n".join(out)
 
@@ -322,19 +737,38 @@ def sweep_section(sweep):
     opts = sweep["options"]
     labels = opts["offset_labels"]
     eps_values = sorted(opts["eps"], reverse=True)
+    confirm = opts.get("confirm_size")
+    codes = sorted({c.get("cause", "") for g in analysis for c in g["grid"] if not c["stable"]} - {""},
+                   key=lambda k: list(CAUSE_CODES).index(k) if k in CAUSE_CODES else len(CAUSE_CODES))
+    legend = table(["code", "what made the point unstable"],
+                   [[f"<td><b>{esc(CAUSE_CODES.get(k, k[:3]))}</b></td>", f"{k}: {CAUSE_MEANINGS.get(k, '')}"]
+                    for k in codes])
     out = [f"<h2 id=sweep>eps &times; offset sweep</h2><p>The {esc(opts['backend'])} backend at {esc(opts['size'])} "
-           "over hit thresholds eps and re-entry offsets (multiples of eps, and fixed values), each point judged "
-           "against one truth (the oracle, masked as for the default parameters). <b>Stability</b> heatmaps: the "
-           "colour is the share of decided pixels whose hit is wrong (mean over the surface type's scenes, log); "
-           "a tick marks a stable point (every scene passes the conformance checks but the perceptual one, "
-           "which small frames make noisy; a tick on a coloured cell is an error conformance/thresholds.json allows "
-           "with its reason, such as sphere tracing running out of steps near the horizon, on up to 2% of the "
-           "pixels of several scenes and most of a translation prism's); the star, the recommendation: of the stable points whose "
-           "neighbours a decade of eps either side are stable too, one within 10% of the fastest with the most stable "
-           "neighbours on the grid. <b>Steps</b> heatmaps: mean kernel steps per "
-           "ray. The Pareto chart: each grid point's time against its error; the front joins the points no other "
-           "beats on both.</p>"]
+           f"({opts['repetitions']} timed frames a point) over hit thresholds eps and re-entry offsets (multiples of "
+           "eps, and fixed values), each point judged by the conformance suite against one truth (the oracle, "
+           "masked as for the default parameters). A point is <b>stable</b> when its verdict is <b>pass</b> on "
+           "every swept scene of the surface type: no check is left out, and a point at its method's limit is "
+           "not stable.</p>"
+           "<p><b>Stability</b> heatmaps: the colour is the share of decided pixels whose hit is wrong (mean over "
+           "the type's scenes, log); a tick marks a stable point; an unstable point shows what made it "
+           "unstable: the failure class whose threshold the most scenes fail, else (when the hit, crossings or "
+           "trace agreement fails) the class with the most rays, else the check the most scenes fail, as a code "
+           "(legend below) in white where a scene fails and in yellow where every scene that does not pass is "
+           "at the method's limit. The star is the recommendation: of the stable points whose neighbours a "
+           "decade of eps either side are stable too, one within 10% of the fastest with the most stable "
+           "neighbours on the grid; an orange star is a <b>fallback</b>, a stable point none of whose eps "
+           "neighbours is stable. <b>Steps</b> heatmaps: mean kernel steps per ray. The Pareto chart: each grid "
+           "point's time against its error; the front joins the points no other beats on both.</p>"
+           "<p><b>Not noise.</b> Stability is the conformance verdict, which does not depend on timing; the "
+           "timings only choose among stable points within 10% of each other, all of which pass. What small "
+           "frames can change is the verdict itself (a few rays more or less near a threshold), so "
+           + (f"each recommended point was rendered again at {esc(confirm)} on every swept scene of its type, "
+              "and a point that failed there was dropped and the next one chosen (code rc); the table says "
+              "which points were re-checked."
+              if confirm else "these results, written without a re-check at a larger size, may hold a point "
+              "that passes only at this size.") + "</p>" + legend]
     rec_rows = []
+    no_stable = {}  # (surface type, method, why) -> the precisions with no stable point
     types = [t for t in SURFACE_TYPES if any(g["surface_type"] == t for g in analysis)]
     for t in types:
         groups = [g for g in analysis if g["surface_type"] == t]
@@ -371,13 +805,20 @@ def sweep_section(sweep):
                             if c and what == "stability" and c["stable"]:
                                 ax.text(k, r, "\u2713", ha="center", va="center", color="#33ff77", fontsize=11,
                                         fontweight="bold", path_effects=[withStroke(linewidth=2, foreground="black")])
+                            elif c and what == "stability":
+                                cause = c.get("cause", "")
+                                at_limit = c.get("limits", 0) > 0 and \
+                                    c.get("limits", 0) == c["scenes"] - c["passed"] - c["errors"]
+                                ax.text(k, r, CAUSE_CODES.get(cause, cause[:3]), ha="center", va="center",
+                                        fontsize=7.5, color="#ffd700" if at_limit else "white",
+                                        path_effects=[withStroke(linewidth=1.6, foreground="black")])
                             if c and what == "steps" and not math.isnan(grid[r][k]):
                                 ax.text(k, r, f"{grid[r][k]:.0f}", ha="center", va="center", fontsize=6,
                                         color="white" if grid[r][k] < 40 else "black")
                     rec = g.get("recommended")
                     if rec:
                         ax.plot(labels.index(rec["offset_label"]), eps_values.index(rec["eps"]), marker="*",
-                                ms=16, mfc="none", mec="#00bfff", mew=2)
+                                ms=16, mfc="none", mec="#ff8c00" if rec.get("fallback") else "#00bfff", mew=2)
                     ax.set_xticks(range(len(labels)), labels, rotation=60, fontsize=7)
                     ax.set_yticks(range(len(eps_values)), [f"{e:g}" for e in eps_values], fontsize=7)
                     ax.set_title(f"{m}, {prec}", fontsize=9)
@@ -410,12 +851,43 @@ def sweep_section(sweep):
             ax.legend(fontsize=7)
         fig.tight_layout()
         out.append(figure_html(fig, f"pareto, {t}"))
+        stable_methods = {g["precision"]: [] for g in groups}
+        for g in groups:
+            if g.get("recommended"):
+                stable_methods[g["precision"]].append(g["method"])
         for g in groups:
             r = g.get("recommended")
-            rec_rows.append([t, g["method"], g["precision"], f'{len(g["stable"])}/{len(g["grid"])}',
-                             f'{r["eps"]:g}' if r else "-", f'{r["offset"]:g} ({r["offset_label"] if r["offset_label"].endswith("xeps") else "fixed"})' if r else "-",
-                             (f'{r["time_ms"]:.3g} ms, {pct(r["hit_mismatch"])} wrong' if r else "nothing stable")])
-    out.insert(1, table(["surface type", "method", "precision", "stable points", "eps", "offset", "at"], rec_rows))
+            if r:
+                k = r.get("confirmed")
+                check = (f'passes at {esc(k["size"])} on {len(k["scenes"])} scene(s)' if k else
+                         "not re-checked")
+                note = "<b>fallback</b>: no stable eps neighbour" if r.get("fallback") else ""
+                rule = r["offset_label"] if r["offset_label"].endswith("xeps") else "fixed"
+                rec_rows.append([t, g["method"], g["precision"], f'{len(g["stable"])}/{len(g["grid"])}',
+                                 f'{r["eps"]:g}', f'{r["offset"]:g} ({rule})',
+                                 f'{r["time_ms"]:.3g} ms, {pct(r["hit_mismatch"])} hit wrong', check,
+                                 f'<td class="{"limit" if note else ""}">{note}</td>'])
+                continue
+            others = [m for m in stable_methods[g["precision"]] if m != g["method"]]
+            causes = {}
+            for c in g["grid"]:
+                if c.get("cause"):
+                    causes[c["cause"]] = causes.get(c["cause"], 0) + 1
+            top = max(causes, key=causes.get) if causes else None
+            advice = (f'use <b>{esc(others[0])}</b>, which is stable here' + (
+                f' (or {esc(", ".join(others[1:]))})' if others[1:] else "") if others
+                else "no method is stable here")
+            rec_rows.append([t, g["method"], g["precision"], f'0/{len(g["grid"])}', "-", "-",
+                             f'<td class="bad">nothing stable{f": mostly {esc(top)}" if top else ""}</td>', "-",
+                             f"<td>{advice}</td>"])
+            why = f'no point of the grid passes on every scene{f" (most often: {esc(top)})" if top else ""}; ' + advice
+            no_stable.setdefault((t, g["method"], why), []).append(g["precision"])
+    out.insert(1, table(["surface type", "method", "precision", "stable points", "eps", "offset", "at",
+                         "re-check", "note"], rec_rows))
+    if no_stable:
+        out.insert(2, '<p class="bad">Where no point is stable:</p><ul>' + "".join(
+            f'<li><b>{esc(m)}</b> ({esc(", ".join(precisions))}) on {esc(t)} surfaces: {why}.</li>'
+            for (t, m, why), precisions in no_stable.items()) + "</ul>")
     return "\n".join(out)
 
 
@@ -463,25 +935,46 @@ body {{ font-family: sans-serif; margin: 1.5em auto; max-width: 1500px; color: #
 table {{ border-collapse: collapse; margin: 0.6em 0; font-size: 0.85em; }}
 th, td {{ border: 1px solid #ccc; padding: 3px 6px; text-align: left; vertical-align: top; }}
 th {{ background: #eee; }} td.bad {{ background: #fdd; }} .bad {{ color: #a00; }} .good {{ color: #070; }}
+td.limit, td.warn {{ background: #fff1c8; }}
 img.chart {{ max-width: 100%; display: block; margin: 0.5em 0; }} img.frame {{ width: 200px; }}
 .choice {{ font-size: 1.1em; background: #eef6ff; padding: 0.6em; }} nav a {{ margin-right: 1em; }}
+.counts {{ display: flex; gap: 0.8em; margin: 0.6em 0; }}
+.count {{ padding: 0.4em 1em; border-radius: 4px; font-size: 1.2em; border: 1px solid #ccc; }}
+.count b {{ font-size: 1.4em; }} .count.pass {{ background: #dff3df; }} .count.limit {{ background: #fff1c8; }}
+.count.fail, .count.error {{ background: #fdd; }}
+.verdict {{ padding: 0 0.4em; border-radius: 3px; font-weight: bold; font-size: 0.9em; }}
+.verdict.pass {{ background: #dff3df; color: #060; }} .verdict.limit {{ background: #fff1c8; color: #750; }}
+.verdict.fail, .verdict.error {{ background: #fdd; color: #a00; }}
+.verdict-line {{ font-size: 1.05em; }} table.reasons td {{ max-width: 900px; }}
+table.recommended img.frame {{ width: 320px; }} ul.legend {{ columns: 2; margin: 0.3em 0; }}
+.swatch {{ display: inline-block; width: 0.9em; height: 0.9em; border: 1px solid #555; margin: 0 0.25em;
+  vertical-align: middle; }}
 </style></head><body>{body}</body></html>"""
 
 
-def one_machine(results, images):
+def one_machine(results, images, previous=None, previous_path=""):
     cases = results.get("matrix", {}).get("cases", [])
+    sections = [("summary", "verdicts", summary_section(results, cases)),
+                ("ranking", "ranking", ranking_section(results)),
+                ("recommended", "recommended choice", recommended_gallery_section(results, images)),
+                ("regression", "regression gate", regression_section(results)),
+                ("previous", "since the earlier run", previous_section(results, previous, previous_path)),
+                ("failures", "failures", failure_section(cases)),
+                ("ambiguity", "ambiguity", ambiguity_section(cases)),
+                ("speed", "speed vs accuracy", speed_accuracy_section(cases)),
+                ("gallery", "gallery", gallery_section(results, images)),
+                ("steps", "steps", steps_heatmap_section(cases)),
+                ("sweep", "eps x offset", sweep_section(results.get("sweep", {}))),
+                ("scaling", "scaling", scaling_section(results.get("scaling", {}))),
+                ("definitions", "definitions", definitions_section(results, cases)),
+                ("machine", "machine", "<h2 id=machine>Machine</h2>" +
+                 table(["", ""], fingerprint_rows(results["fingerprint"])))]
     body = [f"<h1>flatmarch report</h1><p>Measured {esc(results.get('created'))}: timed frames "
             f"{esc(results['options']['size'])} (median of {results['options']['repetitions']} repetitions, "
             f"Google Benchmark), conformance frames {esc(results['options']['conform_size'])}, eps "
             f"{results['options']['eps']:g}, offset {results['options']['offset']:g}.</p>",
-            "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t in [
-                ("ranking", "ranking"), ("speed", "speed vs accuracy"), ("gallery", "gallery"), ("steps", "steps"),
-                ("failures", "failures"), ("sweep", "eps x offset"), ("scaling", "scaling"), ("machine", "machine")]) +
-            "</nav>",
-            ranking_section(results), speed_accuracy_section(cases), gallery_section(results, images),
-            steps_heatmap_section(cases), failure_section(cases), sweep_section(results.get("sweep", {})),
-            scaling_section(results.get("scaling", {})),
-            "<h2 id=machine>Machine</h2>" + table(["", ""], fingerprint_rows(results["fingerprint"]))]
+            "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t, html_ in sections if html_) + "</nav>"]
+    body += [html_ for _, _, html_ in sections if html_]
     return PAGE.format(title="flatmarch report", body="\n".join(body))
 
 
@@ -559,20 +1052,34 @@ def machines(all_results, names):
     return PAGE.format(title="flatmarch: machines compared", body="\n".join(body))
 
 
+def read_results(path):
+    """A results file of `flatmarch report`; exits with a message for anything else."""
+    try:
+        with open(path) as f:
+            r = json.load(f)
+    except (OSError, ValueError) as e:
+        sys.exit(f"error: {path}: {e}")
+    missing = [k for k in ("fingerprint", "matrix", "ranking") if not isinstance(r, dict) or k not in r]
+    if missing:
+        sys.exit(f'error: {path}: no "{missing[0]}": not a results file of `flatmarch report`')
+    return r
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("results", nargs="+", help="results.json files of flatmarch report")
     parser.add_argument("-o", "--out", required=True, help="output folder")
+    parser.add_argument("--previous", help="an earlier run's results.json: the change per case")
     args = parser.parse_args()
-    all_results = []
-    for path in args.results:
-        with open(path) as f:
-            all_results.append(json.load(f))
+    all_results = [read_results(path) for path in args.results]
+    previous = read_results(args.previous) if args.previous else None
+    if previous is not None and len(all_results) > 1:
+        parser.error("--previous compares one run with an earlier one: give one results file")
     os.makedirs(args.out, exist_ok=True)
     use_registry(all_results)
     if len(all_results) == 1:
         images = os.path.join(os.path.dirname(os.path.abspath(args.results[0])), "images")
-        page = one_machine(all_results[0], images)
+        page = one_machine(all_results[0], images, previous, args.previous)
     else:
         names = [f'{os.path.basename(os.path.dirname(os.path.abspath(p))) or p}: '
                  f'{r["fingerprint"]["cpu"]["model"]}{gpu_text(r["fingerprint"])}'

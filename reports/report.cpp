@@ -9,6 +9,7 @@
 #include <set>
 
 #include "reports/fingerprint.hpp"
+#include "reports/gallery.hpp"
 #include "reports/surfaces.hpp"
 
 namespace flatmarch::reports {
@@ -40,7 +41,9 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
   // The lists make_report.py draws by (it restates none).
   json methods = json::array();
   for (Method m : kKernelMethods) methods.push_back(to_string(m));
-  results["registry"] = {{"backends", kernel_backend_names()}, {"methods", methods}};
+  results["registry"] = {{"backends", kernel_backend_names()},
+                         {"methods", methods},
+                         {"surface_types", surface_types()}};
   results["options"] = {
       {"size", std::to_string(o.matrix.width) + "x" + std::to_string(o.matrix.height)},
       {"conform_size",
@@ -85,6 +88,14 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
   results["seconds"]["scaling"] = lap();
   results["ranking"] = rank_backends(results["matrix"]);
   results["recommendation"] = recommend(results["ranking"], results.value("sweep", json::object()));
+  if (!o.matrix.images.empty())
+    results["gallery"] = recommended_gallery(scenes, results["recommendation"],
+                                             {.width = o.matrix.width,
+                                              .height = o.matrix.height,
+                                              .params = o.matrix.params,
+                                              .backend_options = o.matrix.backend_options,
+                                              .images = o.matrix.images});
+  results["seconds"]["gallery"] = lap();
   return results;
 }
 
@@ -191,26 +202,51 @@ json recommend(const json& ranking, const json& sweep) {
   r["backend"] = (*top)["backend"];
   r["method"] = (*top)["best_method"];
   r["rays_per_s"] = (*top)["methods"][(*top)["best_method"].get<std::string>()]["rays_per_s"];
-  r["why"] =
-      "the fastest backend of those that passed every conformance case, with its fastest "
-      "method of those that passed on every scene";
+  // Said as it is: when no backend passed every case (a case at its method's limit is no pass),
+  // the choice is the fastest backend with a method that passed on every scene.
+  r["why"] = (*top)["passed"] == (*top)["cases"]
+                 ? "the fastest backend of those that passed every conformance case, with its "
+                   "fastest method of those that passed on every scene"
+                 : "no backend passed every conformance case (" +
+                       (*top)["backend"].get<std::string>() + ": " +
+                       std::to_string((*top)["passed"].get<int>()) + " of " +
+                       std::to_string((*top)["cases"].get<int>()) + " pass, " +
+                       std::to_string((*top).value("limits", 0)) +
+                       " at their method's limit): the fastest backend with a method that passed "
+                       "on every scene, and its fastest such method";
   const MarchParams defaults;
   json parameters = json::object();
+  const json analysis = sweep.value("analysis", json::array());
   // The surface types the sweep measured; `select` gives the defaults for the others.
   for (const std::string& type : surface_types()) {
-    const json analysis = sweep.value("analysis", json::array());
     if (std::none_of(analysis.begin(), analysis.end(),
                      [&](const json& g) { return g["surface_type"] == type; }))
       continue;
-    json choice = {{"eps", defaults.eps}, {"offset", defaults.offset}, {"source", "defaults"}};
-    for (const json& g : sweep.value("analysis", json::array()))
-      if (g["surface_type"] == type && g["method"] == r["method"] && g["precision"] == "f32" &&
-          !g["recommended"].is_null()) {
-        choice = {{"eps", g["recommended"]["eps"]},
-                  {"offset", g["recommended"]["offset"]},
-                  {"offset_label", g["recommended"]["offset_label"]},
-                  {"source", "sweep"}};
-      }
+    // A fallback is marked as one: the defaults where the method has no stable point, or a
+    // stable point none of whose eps neighbours is stable. With the defaults come the methods
+    // that are stable on this surface type (f32, as the kernel backends march).
+    json choice = {{"eps", defaults.eps},
+                   {"offset", defaults.offset},
+                   {"source", "defaults"},
+                   {"fallback", true},
+                   {"stable_methods", json::array()}};
+    json stable_methods = json::array();
+    for (const json& g : analysis) {
+      if (g["surface_type"] != type || g["precision"] != "f32" || g["recommended"].is_null())
+        continue;
+      const json& rec = g["recommended"];
+      if (g["method"] == r["method"])
+        choice = {{"eps", rec["eps"]},
+                  {"offset", rec["offset"]},
+                  {"offset_label", rec["offset_label"]},
+                  {"source", "sweep"},
+                  {"fallback", rec.value("fallback", false)},
+                  {"confirmed", rec.value("confirmed", json(nullptr))}};
+      else
+        stable_methods.push_back(
+            {{"method", g["method"]}, {"eps", rec["eps"]}, {"offset", rec["offset"]}});
+    }
+    if (choice["source"] == "defaults") choice["stable_methods"] = stable_methods;
     parameters[type] = choice;
   }
   r["parameters"] = parameters;
@@ -232,10 +268,21 @@ std::string describe_selection(const json& results, const std::string& type) {
            rec["backend"].get<std::string>() + " --method " + rec["method"].get<std::string>() +
            " --eps " + number(p["eps"]) + " --offset " + number(p["offset"]) + note + "\n";
   };
-  for (const auto& [t, p] : rec["parameters"].items())
-    if (type.empty() || t == type)
-      s += line_for(t, p,
-                    p["source"] == "sweep" ? "" : "   (defaults: the sweep found no stable point)");
+  for (const auto& [t, p] : rec["parameters"].items()) {
+    if (!type.empty() && t != type) continue;
+    std::string note;
+    if (p["source"] != "sweep") {
+      note = "   (a fallback, the defaults: no point of the sweep passes on every " + t +
+             " scene with this method";
+      for (const json& m : p.value("stable_methods", json::array()))
+        note += "; stable there: --method " + m["method"].get<std::string>() + " --eps " +
+                number(m["eps"]) + " --offset " + number(m["offset"]);
+      note += ")";
+    } else if (p.value("fallback", false)) {
+      note = "   (a fallback: no stable point of the sweep has stable eps neighbours)";
+    }
+    s += line_for(t, p, note);
+  }
   if (!type.empty() && !rec["parameters"].contains(type)) {
     const MarchParams defaults;
     s += line_for(type, {{"eps", defaults.eps}, {"offset", defaults.offset}},
@@ -303,6 +350,15 @@ json make_baseline(const json& results) {
           {"tolerances", tolerances},
           {"cases", cases},
           {"timings_ms", timings}};
+}
+
+std::string baseline_mismatch(const json& baseline, const json& results) {
+  if (baseline.value("format", "") != "flatmarch-baseline/1") return "it is not a baseline file";
+  for (const char* key : {"size", "conform_size", "eps", "offset", "max_steps"})
+    if (baseline["options"][key] != results["options"][key])
+      return "it was measured with " + std::string(key) + " " + baseline["options"][key].dump() +
+             ", this run with " + results["options"][key].dump();
+  return "";
 }
 
 double mann_whitney_p(const std::vector<double>& a, const std::vector<double>& b) {

@@ -28,7 +28,8 @@ using ReportProgress =
     std::function<void(const std::string& stage, const std::string& line, int done, int total)>;
 
 // Runs what the options ask on the scenes and returns the results document: "format",
-// "created", "fingerprint", "options", "matrix", "sweep", "scaling", "ranking", "recommendation".
+// "created", "fingerprint", "options", "matrix", "sweep", "scaling", "ranking", "recommendation",
+// and with matrix images, "gallery" (recommended_gallery()).
 nlohmann::json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
                           const ReportProgress& progress);
 
@@ -49,6 +50,10 @@ std::string describe_selection(const nlohmann::json& results, const std::string&
 // The deterministic figures of a results document per case (steps, crossings, conformance
 // rates), with the tolerances they are held to, and the timing samples (informative only).
 nlohmann::json make_baseline(const nlohmann::json& results);
+
+// Why `baseline` cannot judge `results` (not a baseline file, or measured at another size,
+// conform size, eps, offset or max_steps), or "" when it can.
+std::string baseline_mismatch(const nlohmann::json& baseline, const nlohmann::json& results);
 
 // Compares results with a baseline: "regressions" (a deterministic figure worse beyond its
 // tolerance, or a case that passed now failing), "improvements" (better beyond tolerance: the

@@ -27,6 +27,9 @@ struct SweepOptions {
   MarchParams params;  // max_steps, max_distance, omega
   int width = 64, height = 36;
   int repetitions = 3;  // frames timed per point (median)
+  // The recommended point of each group is checked again at this multiple of the frame size on
+  // every scene of its type, and replaced when it fails there; 1: not checked again.
+  int confirm_scale = 2;
 };
 
 // The label of an offset rule on the grid's axis: "2xeps", or the fixed value ("0.01").
@@ -35,16 +38,21 @@ std::vector<std::string> offset_labels(const SweepOptions& options);
 using SweepProgress = std::function<void(const std::string& line, int done, int total)>;
 
 // Runs the grid on the scenes. Returns {"options", "points": one per scene x method x precision x
-// eps x offset, "analysis": analyse_sweep(points)}. Throws std::invalid_argument for an unknown
-// or unavailable backend.
+// eps x offset, "confirmations": the recommended points checked again at confirm_scale times the
+// size, "analysis": analyse_sweep(points, confirmations)}. Throws std::invalid_argument for an
+// unknown or unavailable backend.
 nlohmann::json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& options,
                          conformance::Suite& suite, const SweepProgress& progress);
 
-// Per surface type x method x precision: "grid" (per eps x offset: scenes passed of scenes —
-// every conformance check but the perceptual one, which small frames make noisy —
-// mean time_ms, mean steps_mean, mean hit_mismatch, traces diverged, failures), "stable" (the
-// grid points every scene passes), "pareto" (points no other beats on both time and hit
-// mismatch), "recommended" ({eps, offset, offset_label, why}; null when nothing is stable).
-nlohmann::json analyse_sweep(const nlohmann::json& points);
+// Per surface type x method x precision: "grid" (per eps x offset: scenes whose conformance
+// verdict is pass, at the method's limit, in error; the checks failed and the failure class
+// counts over the scenes; "cause", the one that made the point unstable; mean time_ms,
+// steps_mean, hit_mismatch; traces diverged, failures), "stable" (the grid points that pass on
+// every scene, and in their re-check at a larger size if they had one), "pareto" (points no
+// other beats on both time and hit mismatch), "recommended" ({eps, offset, offset_label,
+// fallback: no stable neighbours, confirmed: its re-check or null, why}; null when nothing is
+// stable). `confirmations` are run_sweep's re-checks.
+nlohmann::json analyse_sweep(const nlohmann::json& points,
+                             const nlohmann::json& confirmations = nlohmann::json::array());
 
 }  // namespace flatmarch::reports

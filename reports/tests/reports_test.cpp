@@ -7,6 +7,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "output/image_io.hpp"
+#include "reports/gallery.hpp"
 #include "reports/report.hpp"
 #include "reports/surfaces.hpp"
 #include "scene/load.hpp"
@@ -97,6 +99,7 @@ TEST(Statistics, MannWhitneyAsScipyComputesIt) {
 }
 
 // A sweep point as run_sweep writes it.
+// A sweep point; one that does not pass fails hit_rate with some wrong edges.
 json point(const std::string& scene, double eps, const std::string& label, bool passed,
            double time_ms, double mismatch) {
   return {{"scene", scene},
@@ -111,11 +114,28 @@ json point(const std::string& scene, double eps, const std::string& label, bool 
           {"steps_p99", 20.0},
           {"accuracy",
            {{"passed", passed},
+            {"verdict", passed ? "pass" : "fail"},
             {"failed", passed ? json::array() : json::array({"hit_rate"})},
+            {"failures", {{"stuck", 0}, {"wrong_edge", passed ? 0 : 5}}},
             {"hit_mismatch", mismatch},
             {"traces", 8},
             {"traces_diverged", passed ? 0 : 1},
             {"failures_total", passed ? 0 : 5}}}};
+}
+
+// The point at its method's limit: rays out of steps, failing hit_rate and failures.stuck.
+json limit_point(const std::string& scene, double eps, const std::string& label) {
+  json p = point(scene, eps, label, false, 1.0, 0.3);
+  p["accuracy"]["verdict"] = "limit";
+  p["accuracy"]["failed"] = {"hit_rate", "failures.stuck"};
+  p["accuracy"]["failures"] = {{"stuck", 40}, {"wrong_edge", 2}};
+  return p;
+}
+
+const json& cell(const json& group, double eps, const std::string& label) {
+  for (const json& c : group["grid"])
+    if (c["eps"] == eps && c["offset_label"] == label) return c;
+  throw std::runtime_error("no such cell");
 }
 
 TEST(SweepAnalysis, RecommendsTheFastestPointWithStableNeighbours) {
@@ -142,6 +162,65 @@ TEST(SweepAnalysis, RecommendsTheFastestPointWithStableNeighbours) {
     if (cell["eps"] == 1e-2) {
       EXPECT_EQ(cell["passed"], 1);
     }
+}
+
+// Stable means the verdict pass on every scene: a limit is not, and the cell says what made it
+// unstable, a failure class before a check that fails with it.
+TEST(SweepAnalysis, ALimitIsUnstableAndEachCellNamesItsCause) {
+  json points = json::array();
+  for (const std::string scene : {"a", "b"}) {
+    points.push_back(point(scene, 1e-3, "2xeps", true, 1.0, 0.0));
+    points.push_back(point(scene, 1e-2, "2xeps", scene == "a", 1.0, 0.1));
+  }
+  points.push_back(limit_point("a", 1e-4, "2xeps"));
+  points.push_back(point("b", 1e-4, "2xeps", true, 1.0, 0.0));
+  json perceptual = point("a", 1e-5, "2xeps", false, 1.0, 0.0);
+  perceptual["accuracy"]["failed"] = {"image.perceptual_failpercent"};
+  perceptual["accuracy"]["failures"] = {{"stuck", 0}};
+  points.push_back(perceptual);
+  points.push_back(point("b", 1e-5, "2xeps", true, 1.0, 0.0));
+  const json g = analyse_sweep(points)[0];
+  EXPECT_TRUE(cell(g, 1e-3, "2xeps")["stable"].get<bool>());
+  EXPECT_EQ(cell(g, 1e-3, "2xeps")["cause"], "");
+  const json& limit = cell(g, 1e-4, "2xeps");
+  EXPECT_FALSE(limit["stable"].get<bool>());
+  EXPECT_EQ(limit["limits"], 1);
+  EXPECT_EQ(limit["cause"], "stuck");
+  EXPECT_EQ(limit["failed_checks"]["hit_rate"], 1);
+  EXPECT_EQ(limit["failures_by_class"]["stuck"], 40);
+  EXPECT_EQ(cell(g, 1e-2, "2xeps")["cause"], "wrong_edge");
+  // No check is left out, the perceptual one included.
+  EXPECT_FALSE(cell(g, 1e-5, "2xeps")["stable"].get<bool>());
+  EXPECT_EQ(cell(g, 1e-5, "2xeps")["cause"], "image.perceptual_failpercent");
+  // The only stable point has no stable eps neighbours: a fallback, marked.
+  EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-3);
+  EXPECT_TRUE(g["recommended"]["fallback"].get<bool>());
+  EXPECT_TRUE(g["recommended"]["confirmed"].is_null());
+}
+
+// A recommended point whose re-check at a larger size fails is no longer stable: the next is
+// recommended; one that passes it carries it.
+TEST(SweepAnalysis, AFailedRecheckMovesTheRecommendation) {
+  json points = json::array();
+  const double eps[] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6};
+  for (int e = 0; e < 5; ++e) points.push_back(point("a", eps[e], "2xeps", true, 1.0 + e, 0.0));
+  const json first = analyse_sweep(points)[0]["recommended"];
+  ASSERT_EQ(first["eps"].get<double>(), 1e-3);  // the fastest with both neighbours stable
+  EXPECT_FALSE(first["fallback"].get<bool>());
+  const json recheck = {
+      {"surface_type", "translation"}, {"method", "sphere"}, {"precision", "f32"}, {"eps", 1e-3},
+      {"offset_label", "2xeps"},       {"size", "128x72"},   {"passed", false}};
+  const json g = analyse_sweep(points, json::array({recheck}))[0];
+  EXPECT_FALSE(cell(g, 1e-3, "2xeps")["stable"].get<bool>());
+  EXPECT_EQ(cell(g, 1e-3, "2xeps")["cause"], "confirmation");
+  // 1e-4 has lost its stable neighbour 1e-3: of the interior points only 1e-5 is left.
+  EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-5);
+  json passed = recheck;
+  passed["eps"] = 1e-5;
+  passed["passed"] = true;
+  const json again = analyse_sweep(points, json::array({recheck, passed}))[0]["recommended"];
+  EXPECT_EQ(again["eps"].get<double>(), 1e-5);
+  EXPECT_EQ(again["confirmed"]["size"], "128x72");
 }
 
 TEST(SweepAnalysis, NothingStableRecommendsNothing) {
@@ -189,6 +268,76 @@ TEST(Ranking, ConformingBackendsFirstThenBySpeed) {
   EXPECT_EQ(rec["backend"], "slow");
   EXPECT_EQ(rec["method"], "analytic");
   EXPECT_TRUE(rec["parameters"].empty());  // no sweep: select falls back to the defaults
+}
+
+// When no backend passes every case, the recommendation does not say it does.
+TEST(Ranking, ARecommendationWithoutAConformingBackendSaysSo) {
+  json cases = json::array();
+  for (const std::string scene : {"x", "y"}) {
+    cases.push_back(matrix_case("cpu", "sphere", scene, 2e6, scene == "x", 10));
+    cases.back()["accuracy"]["verdict"] = scene == "x" ? "pass" : "limit";
+    cases.push_back(matrix_case("cpu", "analytic", scene, 1e6, true, 3));
+  }
+  const json rec = recommend(rank_backends({{"cases", cases}}), json::object());
+  EXPECT_EQ(rec["method"], "analytic");
+  EXPECT_EQ(rec["why"],
+            "no backend passed every conformance case (cpu: 3 of 4 pass, 1 at their method's "
+            "limit): the fastest backend with a method that passed on every scene, and its fastest "
+            "such method");
+}
+
+// Where the recommended method has no stable point on a surface type, select falls back to the
+// defaults, says so, and names the method that is stable there; a sweep point without stable
+// neighbours is a fallback too.
+TEST(Ranking, AFallbackIsMarkedAndNamesTheStableMethod) {
+  json cases = json::array();
+  for (const std::string scene : {"x", "y"}) {
+    cases.push_back(matrix_case("scalar", "sphere", scene, 4e6, true, 10));
+    cases.push_back(matrix_case("scalar", "analytic", scene, 1e6, true, 3));
+  }
+  const json ranking = rank_backends({{"cases", cases}});
+  const auto group = [](const std::string& type, const std::string& method, json recommended) {
+    return json{{"surface_type", type},
+                {"method", method},
+                {"precision", "f32"},
+                {"recommended", recommended}};
+  };
+  const json sweep = {
+      {"analysis",
+       {group("prism", "sphere", nullptr),
+        group("prism", "analytic",
+              {{"eps", 1e-5}, {"offset", 1e-4}, {"offset_label", "10xeps"}, {"fallback", false}}),
+        group("translation", "sphere",
+              {{"eps", 1e-3}, {"offset", 2e-3}, {"offset_label", "2xeps"}, {"fallback", true}})}}};
+  const json rec = recommend(ranking, sweep);
+  ASSERT_EQ(rec["method"], "sphere");
+  EXPECT_EQ(
+      rec["why"].get<std::string>().rfind("the fastest backend of those that passed every", 0), 0u);
+  const json& prism = rec["parameters"]["prism"];
+  EXPECT_EQ(prism["source"], "defaults");
+  EXPECT_TRUE(prism["fallback"].get<bool>());
+  ASSERT_EQ(prism["stable_methods"].size(), 1u);
+  EXPECT_EQ(prism["stable_methods"][0]["method"], "analytic");
+  const json& translation = rec["parameters"]["translation"];
+  EXPECT_EQ(translation["source"], "sweep");
+  EXPECT_TRUE(translation["fallback"].get<bool>());
+  const json results = {{"recommendation", rec},
+                        {"ranking", ranking},
+                        {"fingerprint",
+                         {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
+                          {"vulkan", json::object()},
+                          {"opengl", json::object()}}}};
+  const std::string text = describe_selection(results, "");
+  EXPECT_NE(text.find("prism       --backend scalar --method sphere --eps 0.0001 --offset 0.0002"
+                      "   (a fallback, the defaults: no point of the sweep passes on every prism "
+                      "scene with this method; stable there: --method analytic --eps 1e-05 "
+                      "--offset 0.0001)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("--eps 0.001 --offset 0.002   (a fallback: no stable point of the sweep has "
+                      "stable eps neighbours)"),
+            std::string::npos)
+      << text;
 }
 
 TEST(Ranking, SimdShareOfPeakIsTheGeometricMeanPerMethod) {
@@ -288,6 +437,59 @@ TEST(Gate, SlowerTimingsWarnOnlyWhenSignificant) {
   EXPECT_FALSE(check["same_machine"].get<bool>());
 }
 
+// The recommended method's gallery: its image and a map of where it differs from the oracle,
+// whose classes count every pixel; a method far off (eps 0.1, offset 1: a push skips a quarter
+// of the room) shows its failures in their colours.
+TEST(Gallery, TheDifferenceMapCountsEveryPixelAndShowsFailures) {
+  const fs::path dir = test::make_temp_dir();
+  const std::vector<Scene> scenes = {gallery("torus")};
+  json rec = {{"backend", "scalar"}, {"method", "analytic"}, {"parameters", json::object()}};
+  GalleryOptions o;
+  o.width = 48;
+  o.height = 27;
+  o.images = dir;
+  const size_t pixels = 48 * 27;
+  const auto total = [](const json& counts) {
+    size_t n = 0;
+    for (const auto& [k, v] : counts.items()) n += v.get<size_t>();
+    return n;
+  };
+  json g = recommended_gallery(scenes, rec, o);
+  ASSERT_EQ(g["scenes"].size(), 1u);
+  json s = g["scenes"][0];
+  ASSERT_FALSE(s.contains("error")) << s.dump();
+  EXPECT_EQ(s["eps"].get<double>(), MarchParams{}.eps);
+  EXPECT_TRUE(fs::exists(dir / s["image"].get<std::string>()));
+  EXPECT_EQ(total(s["counts"]), pixels);
+  EXPECT_GE(s["counts"]["agree"].get<size_t>(), pixels * 95 / 100) << s.dump();
+  EXPECT_EQ(s["counts"]["stuck"], 0);
+
+  rec["method"] = "sphere";
+  rec["parameters"]["translation"] = {{"eps", 0.1}, {"offset", 1.0}};
+  g = recommended_gallery(scenes, rec, o);
+  s = g["scenes"][0];
+  EXPECT_EQ(s["eps"].get<double>(), 0.1);
+  EXPECT_EQ(total(s["counts"]), pixels);
+  const size_t failed = pixels - s["counts"]["agree"].get<size_t>() -
+                        s["counts"]["ambiguous"].get<size_t>() -
+                        s["counts"]["colour"].get<size_t>();
+  EXPECT_GT(failed, pixels / 100) << s.dump();
+  // Every pixel of the map that is a failure's colour is counted as that failure.
+  const Png diff = read_png(dir / s["diff"].get<std::string>());
+  ASSERT_EQ(diff.width, 48);
+  size_t painted = 0;
+  for (const json& entry : g["legend"]) {
+    const std::string name = entry["class"], hex = entry["colour"];
+    if (name == "agree" || name == "ambiguous" || name == "colour") continue;
+    const int r = std::stoi(hex.substr(1, 2), nullptr, 16),
+              gr = std::stoi(hex.substr(3, 2), nullptr, 16),
+              b = std::stoi(hex.substr(5, 2), nullptr, 16);
+    for (size_t px = 0; px < pixels; ++px)
+      painted += diff.rgb[3 * px] == r && diff.rgb[3 * px + 1] == gr && diff.rgb[3 * px + 2] == b;
+  }
+  EXPECT_EQ(painted, failed);
+}
+
 // The commands end to end, on the torus and the scalar backend at a small size.
 TEST(ReportCommand, MeasuresSelectsAndGates) {
   const std::string dir = test::make_temp_dir();
@@ -327,6 +529,11 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_TRUE(c["accuracy"]["passed"].get<bool>());
   EXPECT_GT(c["counters"]["steps_mean"].get<double>(), 1.0);
   EXPECT_EQ(results["recommendation"]["backend"], "scalar");
+  // No --baseline: the committed one was measured at another size, so nothing is checked, and
+  // the page will say why.
+  EXPECT_FALSE(results["regression"]["checked"].get<bool>());
+  EXPECT_NE(results["regression"]["why"].get<std::string>().find("size"), std::string::npos)
+      << results["regression"];
 
   const auto s = test::run_flatmarch({"select", dir + "/results.json", "--scene", torus});
   ASSERT_EQ(s.exit_code, 0) << s.err;
@@ -346,6 +553,12 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_EQ(g.exit_code, 0) << g.out << g.err;
   EXPECT_NE(g.out.find("gate: 1 cases compared"), std::string::npos) << g.out;
   EXPECT_NE(g.out.find("0 regressions"), std::string::npos) << g.out;
+  std::ifstream again(dir + "/again/results.json");
+  const json regression = json::parse(again)["regression"];
+  EXPECT_TRUE(regression["checked"].get<bool>()) << regression;
+  EXPECT_TRUE(regression["given"].get<bool>());
+  EXPECT_EQ(regression["compared"], 1);
+  EXPECT_TRUE(regression["regressions"].empty());
 
   // The page of one run, and the page comparing two (both runs here, for the test).
   const auto page = test::run_flatmarch({"report", dir + "/results.json", "-o", dir + "/page"});
@@ -363,6 +576,16 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_NE(text2.find("machines compared"), std::string::npos);
   // One common case, on the CPU on both machines.
   EXPECT_NE(text2.find("<td>scalar</td><td>CPU</td><td>CPU</td><td>1</td>"), std::string::npos);
+
+  // An earlier run to compare with must be a results file.
+  const auto not_results = test::run_flatmarch(
+      {"report", dir + "/results.json", "-o", dir + "/page", "--previous", dir + "/baseline.json"});
+  EXPECT_EQ(not_results.exit_code, 2);
+  EXPECT_NE(not_results.err.find("--previous: " + dir +
+                                 "/baseline.json has no \"matrix\": not a "
+                                 "results file of `flatmarch report`"),
+            std::string::npos)
+      << not_results.err;
 
   const auto bad = test::run_flatmarch({"select", dir + "/nothing.json"});
   EXPECT_EQ(bad.exit_code, 2);
@@ -479,6 +702,11 @@ TEST(SweepCommand, FindsTheDefaultsStableAndAHugeEpsNot) {
   const json& g = sweep["analysis"][0];
   EXPECT_EQ(g["surface_type"], "translation");
   EXPECT_EQ(g["recommended"]["eps"].get<double>(), 1e-4) << g.dump();
+  // Re-checked at twice the size on the torus, where it passes too.
+  EXPECT_EQ(sweep["options"]["confirm_size"], "96x54");
+  ASSERT_FALSE(g["recommended"]["confirmed"].is_null()) << g.dump();
+  EXPECT_EQ(g["recommended"]["confirmed"]["size"], "96x54");
+  EXPECT_EQ(g["recommended"]["confirmed"]["scenes"]["torus"]["verdict"], "pass");
 }
 
 }  // namespace

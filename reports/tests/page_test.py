@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""The report's page as a browser sees it: a small real report run (two scenes, the scalar
+backend, a tiny sweep) checked against the committed baseline fixture data/page_baseline.json
+(made to regress one figure and improve another) and compared with the earlier run
+data/page_previous.json (one case failed there, one passed that is now at its method's limit),
+loaded in headless Chromium. Checks that the verdicts are counted apart, each non-pass case shows
+every failed check, the regression section shows the gate's verdict and the regressed figure,
+the earlier run's verdict changes are listed, the recommended method's gallery is there, and no
+image of the page is broken.
+
+    page_test.py FLATMARCH OUT      exit 0: passed, 1: failed, 77: skipped (no Chromium)
+"""
+import html
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = os.path.join(HERE, "..", "..", "scenes")
+SKIP = 77
+
+
+def chromium():
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def dump_dom(browser, page, profile):
+    """The page's DOM after load, with the number of images and of broken ones (not decoded, or
+    of no size) written into the body by a script added to a copy of the page."""
+    probe = page.replace(".html", ".probe.html")
+    with open(page) as f:
+        text = f.read()
+    script = ("<script>window.addEventListener('load', () => {const imgs = [...document.images];"
+              "document.body.dataset.images = imgs.length;"
+              "document.body.dataset.broken = imgs.filter(i => !i.complete || i.naturalWidth === 0)"
+              ".map(i => i.alt).join('|') || 'none';});</script>")
+    with open(probe, "w") as f:
+        f.write(text.replace("</body>", script + "</body>"))
+    run = subprocess.run([browser, "--headless", "--no-sandbox", "--disable-gpu", f"--user-data-dir={profile}",
+                          "--dump-dom", "file://" + probe], capture_output=True, text=True, timeout=60)
+    if run.returncode != 0 or "<body" not in run.stdout:
+        sys.exit(f"FAILED: chromium --dump-dom exited {run.returncode}: {run.stderr[-2000:]}")
+    return run.stdout
+
+
+def section(dom, anchor):
+    """The text from the heading with id `anchor` to the next h2."""
+    m = re.search(rf'<h2 id="{anchor}">(.*?)(?=<h2 |$)', dom, re.S)
+    return m.group(1) if m else ""
+
+
+def main():
+    flatmarch, out = sys.argv[1], sys.argv[2]
+    browser = chromium()
+    if not browser:
+        print("SKIPPED: no chromium on this machine (Debian: apt-get install chromium; ci/packages.txt lists it)")
+        return SKIP
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(out)
+    run = subprocess.run(
+        [flatmarch, "report", "--scene", os.path.join(SCENES, "torus.json"),
+         "--scene", os.path.join(SCENES, "l_shape_prism.json"), "--backend", "scalar",
+         "--method", "sphere", "--method", "analytic", "--size", "48x27", "--conform-size", "48x27",
+         "--repetitions", "2", "--min-time", "0.001", "--sweep-size", "16x9", "--no-scaling", "-q",
+         "-o", os.path.join(out, "run"), "--baseline", os.path.join(HERE, "data", "page_baseline.json"),
+         "--previous", os.path.join(HERE, "data", "page_previous.json")],
+        capture_output=True, text=True, timeout=240)
+    failures = []
+
+    def expect(ok, what):
+        if not ok:
+            failures.append(what)
+
+    # The fixture's baseline holds one figure far below what any run measures: the gate fails.
+    expect(run.returncode == 1 and "figures regressed" in run.stderr,
+           f"the run should fail its gate (exit 1), got {run.returncode}: {run.stderr[-1500:]}")
+    if not os.path.exists(os.path.join(out, "run", "index.html")):
+        sys.exit(f"FAILED: the report run wrote no page (exit {run.returncode}): {run.stderr[-2000:]}")
+    with open(os.path.join(out, "run", "results.json")) as f:
+        results = json.load(f)
+    dom = dump_dom(browser, os.path.join(out, "run", "index.html"), os.path.join(out, "profile"))
+    cases = results["matrix"]["cases"]
+    verdicts = [c["accuracy"]["verdict"] for c in cases]
+
+    summary = section(dom, "summary")
+    for v in ("pass", "limit", "fail"):
+        m = re.search(rf'<div class="count {v}"><b>(\d+)</b> {v}</div>', summary)
+        expect(m and int(m.group(1)) == verdicts.count(v),
+               f"summary: {verdicts.count(v)} {v} expected, page says {m.group(1) if m else 'nothing'}")
+    expect("limit" in verdicts, "the run should have a case at its method's limit (sphere in the prism)")
+    for v in ("pass", "limit", "fail"):
+        expect(f'<span class="verdict {v}">{v}</span>' in dom, f"no {v} verdict shown anywhere")
+
+    reasons = section(dom, "failures")
+    for c in cases:
+        a = c["accuracy"]
+        if a["verdict"] == "pass":
+            continue
+        row = re.search(rf'<td data-cases="[^"]*\b{re.escape(c["name"])}\b[^"]*">(.*?)</tr>', reasons, re.S)
+        expect(row, f"failures: no row for {c['name']}")
+        for line in a["failed_checks"] + ([a["limit"]] if a["verdict"] == "limit" else []):
+            expect(row and html.escape(line, quote=False) in row.group(1),
+                   f"failures: {c['name']} does not show {line!r}")
+
+    gate = section(dom, "regression")
+    expect('Gate: <span class="verdict fail">fail</span>' in gate, "regression: the gate's verdict is not fail")
+    row = re.search(r"<td>scalar/sphere/torus/48x27</td><td>steps_mean</td><td>0.5</td><td>([\d.]+)</td>"
+                    r"<td>\+[\d.]+</td><td>0.06</td>", gate)
+    expect(row, "regression: the regressed steps_mean of scalar/sphere/torus/48x27 against 0.5 "
+                "with tolerance 0.06 is not shown")
+    expect("1 improvements" in gate, "regression: the improvement is not counted")
+
+    earlier = section(dom, "previous")
+    changes = re.findall(r'<tr><td>([^<]+)</td><td><span class="verdict (\w+)">\w+</span></td>'
+                         r'<td><span class="verdict (\w+)">\w+</span></td><td>(\w+)</td>', earlier)
+    expect(changes[:1] == [("scalar/sphere/l_shape_prism/48x27", "pass", "limit", "worse")] and
+           ("scalar/analytic/l_shape_prism/48x27", "fail", "pass", "better") in changes,
+           f"previous: verdict changes (worse first) not as expected: {changes}")
+    expect("1 no longer measured" in earlier, "previous: the case no longer measured is not counted")
+
+    gallery = section(dom, "recommended")
+    rec = results["recommendation"]
+    for scene in results["options"]["scenes"]:
+        for alt in (f"{scene}, oracle", f'{scene}, {rec["backend"]} {rec["method"]}', f"{scene}, difference"):
+            expect(f'alt="{alt}"' in gallery, f"recommended gallery: no image {alt!r}")
+
+    for anchor in ("ambiguity", "definitions", "sweep"):
+        expect(section(dom, anchor), f"no {anchor} section")
+    for failure in ("stuck", "wrong_edge", "missed_object", "phantom_hit", "early_escape", "late_escape", "leak"):
+        expect(f"<td>{failure}</td>" in section(dom, "definitions"), f"definitions: no failure class {failure}")
+
+    images = re.search(r'<body data-images="(\d+)" data-broken="([^"]*)"', dom)
+    expect(images and int(images.group(1)) >= 12, f"too few images on the page: {images and images.group(1)}")
+    expect(images and images.group(2) == "none", f"broken images: {images and images.group(2)}")
+    expect('class="missing"' not in dom, "an image file the page wanted is missing")
+
+    for f in failures:
+        print("FAILED:", f)
+    if not failures:
+        print(f"page_test: {len(cases)} cases, verdicts {sorted(set(verdicts))}, {images.group(1)} images: passed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
