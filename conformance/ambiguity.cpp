@@ -267,7 +267,6 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
   Mat2 carried(1.0);
   const auto spread = [&] { return stretch(carried) * spread0; };
   const auto add_spread = [&](double x) { spread0 += x * stretch(glm::inverse(carried)); };
-  int crossings = 0;
   for (size_t k = 0; k < r.path.size(); ++k) {
     const PathSegment& seg = r.path[k];
     const bool last = k + 1 == r.path.size();
@@ -318,7 +317,6 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
         truth.t_slack += params.eps / std::max(std::abs(along), 1e-3) + push;
       }
       add_spread(16.0 * u * scene.scale);
-      ++crossings;
       break;
     }
   }
