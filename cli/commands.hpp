@@ -13,6 +13,7 @@ void add_gallery(CLI::App& app);
 void add_plan(CLI::App& app);
 void add_import_peer(CLI::App& app);
 void add_shader(CLI::App& app);
+void add_export_web(CLI::App& app);
 void add_view(CLI::App& app);
 void add_conform(CLI::App& app);
 void add_report(CLI::App& app);

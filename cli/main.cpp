@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   cli::add_gallery(app);
   cli::add_import_peer(app);
   cli::add_shader(app);
+  cli::add_export_web(app);
   cli::add_view(app);
   cli::add_conform(app);
   cli::add_report(app);

@@ -13,11 +13,14 @@ namespace {
 // Up to this many objects, a baked shader finds a hit solid's normal with the solid's shape known.
 constexpr size_t kFewObjects = 4;
 
-// Nine significant digits read back as the same float.
+// Nine significant digits read back as the same float; always a float literal ("2.0", not "2"),
+// which GLSL ES (the web export) needs where a structure's constructor takes a float.
 std::string number(float x) {
   char text[32];
   std::snprintf(text, sizeof text, "%.9g", static_cast<double>(x));
-  return text;
+  std::string s = text;
+  if (s.find_first_of(".eEni") == std::string::npos) s += ".0";
+  return s;
 }
 
 std::string vec4_literal(const glm::vec4& v) {
@@ -185,6 +188,59 @@ std::string scene_compute_shader(const SceneTables<float>& tables, bool trace, b
   return shader_source(tables.features, baked, trace) + "\n#define TILE " +
          std::to_string(kComputeTile) + "\n" + kComputeMain;
 }
+
+namespace {
+
+// The web page's main(): as kFragmentMain, but the colour sRGB-encoded for the canvas, and no
+// AOV target (a canvas has one colour buffer).
+const char* const kWebFragmentMain = R"glsl(
+uniform int u_polygon;
+uniform vec3 u_from;
+uniform vec3 u_forward;
+uniform vec3 u_right;
+uniform vec3 u_up;
+uniform vec2 u_scale;
+uniform vec2 u_size;
+
+layout(location = 0) out vec4 out_color;
+
+// The sRGB transfer function (IEC 61966-2-1), as OpenImageIO encodes the PNGs of `render`.
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
+void main() {
+  // DESIGN.md section 2: x from the left, y from the top (a canvas's row 0 is its top row).
+  vec2 p = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);
+  float u = (2.0 * p.x / u_size.x - 1.0) * u_scale.x;
+  float v = (1.0 - 2.0 * p.y / u_size.y) * u_scale.y;
+  Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));
+  out_color = vec4(srgb(shade(r)), 1.0);
+}
+)glsl";
+
+// GLSL ES 3.00 (WebGL2) in place of the first line's desktop version.
+std::string as_glsl_es(const std::string& source) {
+  const size_t end = source.find('\n');
+  return "#version 300 es\nprecision highp float;\nprecision highp int;\n" + source.substr(end + 1);
+}
+
+}  // namespace
+
+std::string web_fragment_shader(const SceneTables<float>& tables) {
+  // Plain global arrays, not constants: SwiftShader (Chromium's WebGL without a GPU) crashes its
+  // GPU process on a struct read from a constant array at an index known only at run time.
+  return as_glsl_es(shader_source(tables.features, baked_tables(tables, false)) + kWebFragmentMain);
+}
+
+const char* const kWebVertexShader = R"glsl(#version 300 es
+// One triangle that covers the viewport.
+void main() {
+  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)glsl";
 
 const char* const kFullScreenVertexShader = R"glsl(#version 450
 // One triangle that covers the viewport.

@@ -34,6 +34,13 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays 
 std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace = false,
                                   bool from_band = false);
 
+// The web page's fragment shader (`flatmarch export-web`): the same kernel and baked tables in
+// GLSL ES 3.00 for WebGL2, with the uniforms of scene_fragment_shader but u_rows, and one output,
+// the colour sRGB-encoded for a canvas. Every ray may start outside the band.
+std::string web_fragment_shader(const SceneTables<float>& tables);
+// Its vertex shader: one triangle over the viewport, drawn with 3 vertices and no attributes.
+extern const char* const kWebVertexShader;
+
 // Whether a camera at `position` sees from within the band, as the kernel tests it.
 bool within_band(const SceneTables<float>& tables, const glm::dvec3& position);
 

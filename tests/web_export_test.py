@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""`flatmarch export-web` as a browser sees it (issue 23): scenes of each kind (translation,
+prism, mirror, cone, affine, singularities) exported, each page drawn by headless Chromium
+(WebGL2; SwiftShader where there is no GPU) at 160x90 from the scene's camera with the network
+disabled, and compared with `flatmarch render --backend opengl` at the same camera and size: at
+least 99% of the pixels within 3/255 on every channel. The pages must reference nothing outside
+themselves, and bad options must exit 2 with the reason.
+
+    web_export_test.py FLATMARCH OUT   exit 0: passed, 1: failed, 77: skipped (no Chromium or
+                                       no OpenGL backend)
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+from PIL import Image
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = os.path.join(HERE, "..", "scenes")
+SKIP = 77
+NAMES = ["torus", "l_shape_prism", "mirror_pentagon", "cone_pi", "affine_two_rooms",
+         "double_pentagon_singularities"]
+WIDTH, HEIGHT = 160, 90
+
+
+def chromium():
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def run(args, **kw):
+    return subprocess.run(args, capture_output=True, text=True, timeout=300, **kw)
+
+
+def pixels(png):
+    image = Image.open(png).convert("RGB")
+    return image.size, list(image.getdata())
+
+
+def main():
+    flatmarch, out = sys.argv[1], sys.argv[2]
+    browser = chromium()
+    if not browser:
+        print("skipped: no Chromium (Debian's chromium package; ci/packages.txt installs it)")
+        return SKIP
+    backends = run([flatmarch, "backends"]).stdout
+    if not re.search(r"^opengl\s+yes", backends, re.M):
+        print("skipped: the opengl backend, the page's reference, is unavailable here")
+        return SKIP
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(out)
+    failures = []
+    scenes = [os.path.join(SCENES, n + ".json") for n in NAMES]
+    r = run([flatmarch, "export-web", *scenes, "-o", out])
+    if r.returncode != 0:
+        print("export-web failed:", r.stderr)
+        return 1
+    index = open(os.path.join(out, "index.html")).read()
+    for name in NAMES:
+        page = os.path.join(out, name, "index.html")
+        text = open(page).read()
+        if re.search(r"""(src|href)\s*=\s*["']?(https?:)?//""", text):
+            failures.append(f"{name}: the page references something outside itself")
+        if f'href="{name}/index.html"' not in index:
+            failures.append(f"{name}: not linked from the index page")
+        shot = os.path.join(out, name + ".web.png")
+        # No network: every host resolves to nothing.
+        run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+             "--host-resolver-rules=MAP * ~NOTFOUND",
+             f"--window-size={WIDTH},{HEIGHT}", f"--screenshot={shot}",
+             f"file://{os.path.abspath(page)}?frame={WIDTH}x{HEIGHT}"])
+        ref = os.path.join(out, name + ".gl.png")
+        r = run([flatmarch, "render", os.path.join(SCENES, name + ".json"), "--backend", "opengl",
+                 "--size", f"{WIDTH}x{HEIGHT}", "-o", ref, "-q"])
+        if r.returncode != 0 or not os.path.exists(shot):
+            failures.append(f"{name}: no image (render: {r.stderr.strip()})")
+            continue
+        (size, web), (_, gl) = pixels(shot), pixels(ref)
+        if size != (WIDTH, HEIGHT):
+            failures.append(f"{name}: the page's screenshot is {size}")
+            continue
+        close = sum(max(abs(a - b) for a, b in zip(p, q)) <= 3 for p, q in zip(web, gl))
+        share = close / len(gl)
+        print(f"{name}: {100 * share:.2f}% of the pixels within 3/255 of the opengl backend's")
+        if share < 0.99:
+            failures.append(f"{name}: only {100 * share:.2f}% of the pixels agree")
+    for args, words in [(["--method", "oracle"], "--method"), (["--eps", "-1"], "eps")]:
+        r = run([flatmarch, "export-web", os.path.join(SCENES, "torus.json"), "-o", out + "/bad",
+                 *args])
+        if r.returncode != 2 or words not in r.stderr:
+            failures.append(f"export-web {' '.join(args)}: exit {r.returncode}, {r.stderr.strip()}")
+    for f in failures:
+        print("FAILED:", f)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
