@@ -170,9 +170,21 @@ function screenshot() {
   });
 }
 
+// ?frame=WxH&bench=N: N frames more after the first, timed each (a one-pixel read-back waits
+// for it); the title then says "flatmarch: rendered; median M ms over N frames", and
+// window.flatmarchTimes holds every frame's milliseconds.
+const bench = Math.max(0, Math.min(1000, Number(query.get("bench")) || 0));
 if (gl && frame) {
   document.body.classList.add("frame");
-  try { draw(); document.title = "flatmarch: rendered"; } catch (e) { fail(String(e.message || e)); }
+  try {
+    draw();
+    const times = [];
+    for (let k = 0; k < bench; ++k) { draw(); times.push(lastMs); }
+    window.flatmarchTimes = times;
+    times.sort((a, b) => a - b);
+    document.title = "flatmarch: rendered" + (bench ? "; median " +
+      times[Math.floor(times.length / 2)].toFixed(3) + " ms over " + bench + " frames" : "");
+  } catch (e) { fail(String(e.message || e)); }
 } else if (gl) {
   let drag = null;
   canvas.addEventListener("pointerdown", (e) => { drag = [e.clientX, e.clientY]; canvas.setPointerCapture(e.pointerId); });
@@ -270,7 +282,8 @@ void add_export_web(CLI::App& app) {
       "sphere/relaxed/analytic, [ ] the field of view, - + the resolution, P a screenshot, H the\n"
       "help line. The page takes ?frame=WxH to draw one frame of that size from the scene's "
       "camera\n"
-      "(for comparisons with `flatmarch render`) and ?method=NAME. Walking (and being carried\n"
+      "(for comparisons with `flatmarch render`; &bench=N times N more and puts the median in\n"
+      "the title) and ?method=NAME. Walking (and being carried\n"
       "through gluings, as the viewer is) is not in the page yet. One scene: OUT/index.html;\n"
       "several: OUT/NAME/index.html each and OUT/index.html linking them.");
   struct Options {

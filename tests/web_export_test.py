@@ -3,7 +3,7 @@
 prism, mirror, cone, affine, singularities) exported, each page drawn by headless Chromium
 (WebGL2; SwiftShader where there is no GPU) at 160x90 from the scene's camera with the network
 disabled, and compared with `flatmarch render --backend opengl` at the same camera and size: at
-least 99% of the pixels within 3/255 on every channel. The pages must reference nothing outside
+least 99% of the pixels within 3/255 on every channel. ?bench=N must time frames. The pages must reference nothing outside
 themselves, and bad options must exit 2 with the reason.
 
     web_export_test.py FLATMARCH OUT   exit 0: passed, 1: failed, 77: skipped (no Chromium or
@@ -89,6 +89,15 @@ def main():
         print(f"{name}: {100 * share:.2f}% of the pixels within 3/255 of the opengl backend's")
         if share < 0.99:
             failures.append(f"{name}: only {100 * share:.2f}% of the pixels agree")
+    # Timed frames: ?bench=N puts the median frame time in the title.
+    page = os.path.abspath(os.path.join(out, NAMES[0], "index.html"))
+    dom = run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom",
+               f"file://{page}?frame={WIDTH}x{HEIGHT}&bench=3"]).stdout
+    timed = re.search(r"<title>flatmarch: rendered; median ([0-9.]+) ms over 3 frames", dom)
+    if not timed or float(timed.group(1)) <= 0.0:
+        failures.append(f"?bench=3 gave no frame time: {dom[:200]}")
+    else:
+        print(f"{NAMES[0]}: median {timed.group(1)} ms a {WIDTH}x{HEIGHT} frame in this browser")
     for args, words in [(["--method", "oracle"], "--method"), (["--eps", "-1"], "eps")]:
         r = run([flatmarch, "export-web", os.path.join(SCENES, "torus.json"), "-o", out + "/bad",
                  *args])
