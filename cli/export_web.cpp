@@ -1,6 +1,8 @@
 // `flatmarch export-web`: a scene as a self-contained web page that marches it with WebGL2 (issue
 // 23, first part): the kernel's shader in GLSL ES 3.00, the scene's camera and the viewer's look
 // controls, no network needed to open it.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +15,7 @@
 #include "kernels/compile.hpp"
 #include "kernels/scene_shader.hpp"
 #include "scene/load.hpp"
+#include "viewer/walk.hpp"
 
 namespace flatmarch::cli {
 
@@ -141,7 +144,7 @@ function draw() {
 function showHud(w, h) {
   hud.innerHTML = "<b>" + scene.name + "</b> &middot; " + method + ", eps " + scene.eps +
     ", offset " + scene.offset + " &middot; " + w + "&times;" + h + ", " + lastMs.toFixed(1) + " ms<br>" +
-    "drag or arrow keys: look &middot; 1 sphere, 2 relaxed, 3 analytic &middot; [ ] field of view (" +
+    "W/A/S/D walk, E/Q up and down (Shift: faster) &middot; drag or arrow keys: look &middot; 1 sphere, 2 relaxed, 3 analytic &middot; [ ] field of view (" +
     camera.fov_deg.toFixed(0) + "&deg;) &middot; - + resolution &middot; P screenshot &middot; H hide this";
 }
 
@@ -161,6 +164,149 @@ function look(dyaw, dpitch) {
   redraw();
 }
 
+// Walking (a port of viewer/walk.cpp: the same rules, in double precision): the horizontal path
+// is followed across glued edges, each crossing mapping the point and the rest of the path by
+// the edge's gluing and turning the yaw with it; mirrors and walls stop the walker kWalkMargin
+// short and the rest slides along them; a vertex stops it; z stays inside the band, or is taken
+// modulo the period of a prism; above or below the band the walker flies.
+const W = scene.walk;
+const { margin: kWalkMargin, max_segments: kMaxSegments, reach: kWalkReach } = W;
+const kVertexRadius = 1e-6, kPush = 1e-9;  // as viewer/walk.cpp's own
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1];
+const cross2 = (a, b) => a[0] * b[1] - a[1] * b[0];
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1]];
+const add = (a, b) => [a[0] + b[0], a[1] + b[1]];
+const mul = (k, a) => [k * a[0], k * a[1]];
+const len = (a) => Math.hypot(a[0], a[1]);
+const apply = (m, v) => [m[0] * v[0] + m[2] * v[1], m[1] * v[0] + m[3] * v[1]];
+function edgeDistance(e, p) {
+  if (e.at_infinity) return Infinity;
+  const u = Math.min(Math.max(dot(sub(p, e.start), e.along), 0), e.length === null ? Infinity : e.length);
+  return len(sub(p, add(e.start, mul(u, e.along))));
+}
+function inBand(z) { return W.period !== null || (z >= 0 && z <= W.height); }
+function contains(poly, p, margin) {
+  let inside = false;
+  const pts = poly.outline, n = pts.length;
+  for (let i = 0; i < n; ++i) {
+    const a = pts[i], b = pts[(i + 1) % n];
+    if ((a[1] > p[1]) !== (b[1] > p[1])) {
+      const x = a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+      if (x > p[0]) inside = !inside;
+    }
+  }
+  let d = Infinity;
+  for (const e of poly.edges) d = Math.min(d, edgeDistance(e, p));
+  return inside && d > (margin || 0);
+}
+function exitOf(poly, o, d, vertexRadius, sTolerance) {
+  let best = { s: Infinity, edge: -1 };
+  if (d[0] === 0 && d[1] === 0) return best;
+  poly.edges.forEach((e, i) => {
+    if (dot(d, e.normal) <= 0) return;
+    const denom = cross2(d, e.along);
+    const s = cross2(sub(e.start, o), e.along) / denom;
+    const u = cross2(sub(e.start, o), d) / denom;
+    const length = e.length === null ? Infinity : e.length;
+    if (u < -vertexRadius || u > length + vertexRadius || s < -sTolerance || s > 1) return;
+    if (s < best.s) best = { s: Math.max(s, 0), edge: i };
+  });
+  return best;
+}
+function wrapYaw(y) { return y - 360 * Math.round(y / 360); }
+function turnedYaw(e, yaw) {
+  const angle = Math.atan2(e.linear[1], e.linear[0]) * 180 / Math.PI;
+  if (e.gluing === "reflection") return wrapYaw(angle - yaw);
+  if (e.gluing === "affine") {
+    const f = apply(e.linear, [Math.cos(yaw * Math.PI / 180), Math.sin(yaw * Math.PI / 180)]);
+    return Math.atan2(f[1], f[0]) * 180 / Math.PI;
+  }
+  return wrapYaw(yaw + angle);
+}
+function bandZ(z) {
+  if (W.period !== null) return z - W.period * Math.floor(z / W.period);
+  const margin = Math.min(kWalkMargin, 0.25 * W.height);
+  return Math.min(Math.max(z, margin), W.height - margin);
+}
+function walkRooms(c, d, result) {
+  let o = [c.position[0], c.position[1]];
+  const vertexRadius = kVertexRadius * W.scale;
+  for (let segment = 0; d[0] !== 0 || d[1] !== 0; ++segment) {
+    if (segment === kMaxSegments) { result.blocked = true; break; }
+    const poly = W.polygons[c.polygon];
+    const reach = kWalkReach * W.scale;
+    if (poly.infinite && len(o) + len(d) > reach) {
+      d = mul(Math.max(reach - len(o), 0) / len(d), d);
+      result.blocked = true;
+      if (d[0] === 0 && d[1] === 0) break;
+    }
+    const exit = exitOf(poly, o, d, vertexRadius, vertexRadius / len(d));
+    if (exit.edge < 0) {
+      if (contains(poly, add(o, d), 0)) o = add(o, d); else result.blocked = true;
+      break;
+    }
+    const e = poly.edges[exit.edge];
+    const at = add(o, mul(exit.s, d));
+    const toVertex = Math.min(len(sub(at, e.start)),
+      e.length === null ? Infinity : len(sub(at, add(e.start, mul(e.length, e.along)))));
+    if (toVertex <= vertexRadius) {
+      o = add(o, mul(Math.max(exit.s - kWalkMargin / len(d), 0), d));
+      result.blocked = true;
+      break;
+    }
+    if (e.kind !== "glued") {
+      const s = Math.max(exit.s - kWalkMargin / dot(d, e.normal), 0);
+      o = add(o, mul(s, d));
+      const rest = mul(1 - s, d);
+      d = sub(rest, mul(dot(rest, e.normal), e.normal));
+      result.blocked = true;
+      continue;
+    }
+    const entry = W.polygons[e.to[0]].edges[e.to[1]];
+    const p = add(apply(e.linear, at), e.translation);
+    o = sub(p, mul(dot(sub(p, entry.start), entry.normal) + kPush * W.scale, entry.normal));
+    d = apply(e.linear, mul(1 - exit.s, d));
+    c.yaw_deg = turnedYaw(e, c.yaw_deg);
+    c.polygon = e.to[0];
+    ++result.crossings;
+  }
+  c.position = [o[0], o[1], c.position[2]];
+}
+function fly(c, d, up) {
+  const x = c.position;
+  const above = x[2] > W.height;
+  c.position = [x[0] + d[0], x[1] + d[1], x[2] + up];
+  const z = c.position[2];
+  if (above ? z > W.height : z < 0) return;
+  if (above || !W.floor) {
+    for (let k = 0; k < W.polygons.length; ++k) {
+      if (contains(W.polygons[k], [c.position[0], c.position[1]], kWalkMargin)) {
+        c.polygon = k;
+        c.position[2] = bandZ(z);
+        return;
+      }
+    }
+  }
+  c.position[2] = above ? W.height + kWalkMargin : -kWalkMargin;
+}
+// Moves the camera `forward`, `right` (horizontally, in its yaw frame) and `up`.
+function walk(c, forward, right, up) {
+  const a = c.yaw_deg * Math.PI / 180;
+  const d = [forward * Math.cos(a) + right * Math.sin(a), forward * Math.sin(a) - right * Math.cos(a)];
+  const result = { crossings: 0, blocked: false };
+  if (inBand(c.position[2])) {
+    const z = c.position[2];
+    walkRooms(c, d, result);
+    c.position[2] = bandZ(z + up);
+  } else {
+    fly(c, d, up);
+  }
+  return result;
+}
+
+// A step of walking: a fiftieth of the scene's scale, four times that with Shift.
+function stride(e) { return (e.shiftKey ? 0.08 : 0.02) * W.scale; }
+
 function screenshot() {
   canvas.toBlob((blob) => {
     const a = document.createElement("a");
@@ -174,7 +320,19 @@ function screenshot() {
 // for it); the title then says "flatmarch: rendered; median M ms over N frames", and
 // window.flatmarchTimes holds every frame's milliseconds.
 const bench = Math.max(0, Math.min(1000, Number(query.get("bench")) || 0));
-if (gl && frame) {
+// ?walk=F,R,U;F,R,U...: these walks from the scene's camera first; without ?frame the title then
+// says "flatmarch: walked " and the camera as JSON (tests compare it with viewer/walk.cpp's).
+let walked = null;
+if (query.get("walk") !== null) {
+  let crossings = 0;
+  for (const step of query.get("walk").split(";").filter((x) => x))
+    crossings += walk(camera, ...step.split(",").map(Number)).crossings;
+  walked = JSON.stringify(
+    { polygon: camera.polygon, position: camera.position, yaw_deg: camera.yaw_deg, crossings });
+}
+if (walked !== null && !frame) {
+  document.title = "flatmarch: walked " + walked;
+} else if (gl && frame) {
   document.body.classList.add("frame");
   try {
     draw();
@@ -198,6 +356,9 @@ if (gl && frame) {
     const keys = {
       ArrowLeft: () => look(5, 0), ArrowRight: () => look(-5, 0),
       ArrowUp: () => look(0, 5), ArrowDown: () => look(0, -5),
+      w: () => walk(camera, stride(e), 0, 0), s: () => walk(camera, -stride(e), 0, 0),
+      d: () => walk(camera, 0, stride(e), 0), a: () => walk(camera, 0, -stride(e), 0),
+      e: () => walk(camera, 0, 0, stride(e)), q: () => walk(camera, 0, 0, -stride(e)),
       "1": () => { method = "sphere"; }, "2": () => { method = "relaxed"; }, "3": () => { method = "analytic"; },
       "[": () => { camera.fov_deg = Math.max(10, camera.fov_deg - 5); },
       "]": () => { camera.fov_deg = Math.min(150, camera.fov_deg + 5); },
@@ -207,7 +368,8 @@ if (gl && frame) {
       p: screenshot, P: screenshot,
       h: () => { hud.hidden = !hud.hidden; }, H: () => { hud.hidden = !hud.hidden; },
     };
-    if (keys[e.key]) { keys[e.key](); redraw(); e.preventDefault(); }
+    const key = e.key.length === 1 && /[wasdeq]/i.test(e.key) ? e.key.toLowerCase() : e.key;
+    if (keys[key]) { keys[key](); redraw(); e.preventDefault(); }
   });
   window.addEventListener("resize", redraw);
   redraw();
@@ -226,6 +388,51 @@ std::string replace_all(std::string s, const std::string& from, const std::strin
 // Text as HTML (for the title).
 std::string html_text(const std::string& s) {
   return replace_all(replace_all(replace_all(s, "&", "&amp;"), "<", "&lt;"), ">", "&gt;");
+}
+
+json pair(Vec2 v) {
+  return {v.x, v.y};
+}
+
+// What the page's walk (a port of viewer/walk.cpp) needs of the scene: its band, and each
+// polygon's edges with their gluings and an outline for the inside test (an unbounded room's cut
+// off far beyond where a walk may go, kWalkReach).
+json walk_data(const Scene& scene) {
+  json polygons = json::array();
+  for (const Polygon& polygon : scene.polygons) {
+    double reach = viewer::kWalkReach * scene.scale;
+    for (int i = 0; i < polygon.size(); ++i)
+      if (!polygon.is_ideal(i)) reach = std::max(reach, glm::length(polygon.vertex(i)));
+    json outline = json::array();
+    for (const Vec2 v :
+         polygon.infinite() ? polygon.outline(8.0 * (reach + 1.0)) : polygon.vertices)
+      outline.push_back(pair(v));
+    json edges = json::array();
+    for (const Edge& e : polygon.edges) {
+      const Mat2& m = e.map.linear;
+      edges.push_back(
+          {{"kind", to_string(e.kind)},
+           {"at_infinity", e.shape == EdgeShape::at_infinity},
+           {"start", pair(e.start)},
+           {"along", pair(e.along)},
+           {"length", std::isfinite(e.length) ? json(e.length) : json(nullptr)},
+           {"normal", pair(e.normal)},
+           {"to", {e.to.polygon, e.to.edge}},
+           {"linear", {m[0].x, m[0].y, m[1].x, m[1].y}},
+           {"translation", pair(e.map.translation)},
+           {"gluing",
+            e.gluing >= 0 ? to_string(scene.gluings[static_cast<size_t>(e.gluing)].type) : ""}});
+    }
+    polygons.push_back({{"infinite", polygon.infinite()}, {"outline", outline}, {"edges", edges}});
+  }
+  return {{"margin", viewer::kWalkMargin},
+          {"max_segments", viewer::kMaxSegments},
+          {"reach", viewer::kWalkReach},
+          {"scale", scene.scale},
+          {"height", scene.height},
+          {"period", scene.period ? json(*scene.period) : json(nullptr)},
+          {"floor", scene.floor},
+          {"polygons", polygons}};
 }
 
 // The scene's page.
@@ -248,6 +455,7 @@ std::string page(const Scene& scene, const MarchParams& params) {
                      {"method", to_string(params.method)},
                      {"eps", params.eps},
                      {"offset", params.offset},
+                     {"walk", walk_data(scene)},
                      {"vertex_shader", kernel::kWebVertexShader},
                      {"shaders", shaders}};
   // In a script element "</" would end it early.
@@ -283,8 +491,9 @@ void add_export_web(CLI::App& app) {
       "help line. The page takes ?frame=WxH to draw one frame of that size from the scene's "
       "camera\n"
       "(for comparisons with `flatmarch render`; &bench=N times N more and puts the median in\n"
-      "the title) and ?method=NAME. Walking (and being carried\n"
-      "through gluings, as the viewer is) is not in the page yet. One scene: OUT/index.html;\n"
+      "the title), ?method=NAME, and ?walk=F,R,U;... (walks, as the viewer's, whose end the\n"
+      "title then gives). W/A/S/D walk, E/Q up and down, carried through gluings as in the\n"
+      "viewer. One scene: OUT/index.html;\n"
       "several: OUT/NAME/index.html each and OUT/index.html linking them.");
   struct Options {
     std::vector<std::string> scenes;

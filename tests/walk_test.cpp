@@ -4,13 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <random>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
+#include "tests/process.hpp"
 #include "viewer/walk.hpp"
 
 namespace flatmarch::viewer {
@@ -306,6 +311,56 @@ TEST(Look, TurnsYawAndClampsPitch) {
   EXPECT_DOUBLE_EQ(turned.yaw_deg, -180.0);
   EXPECT_DOUBLE_EQ(turned.pitch_deg, -kMaxPitchDeg);
   EXPECT_EQ(turned.position, c.position);
+}
+
+// The exported web page walks as walk() does (issue 23): the same walks from each scene's camera
+// in headless Chromium (the page's ?walk= hook) end in the same room, at the same point and yaw
+// to 1e-5, after as many crossings. Scenes of every kind of gluing: translations, mirrors,
+// reflections, rotations (a cone), an affine map, a prism's period, an unbounded room.
+TEST(WebWalk, ThePageWalksAsTheViewerDoes) {
+  const char* browsers[] = {"/usr/bin/chromium", "/usr/bin/chromium-browser"};
+  const char* browser = nullptr;
+  for (const char* b : browsers)
+    if (std::filesystem::exists(b)) browser = b;
+  if (!browser) GTEST_SKIP() << "no Chromium (Debian's chromium package)";
+  const std::vector<std::array<double, 3>> walks = {
+      {1.5, 0.0, 0.0}, {0.0, 2.5, 0.2}, {4.0, 0.0, 0.3}, {-3.0, 1.0, 0.0}, {0.7, -5.0, 0.0}};
+  std::string arg;
+  for (const auto& w : walks) arg += test::vec3_arg(Vec3(w[0], w[1], w[2])) + ";";
+  const std::string dir = test::make_temp_dir();
+  int total = 0;
+  for (const std::string name : {"l_shape", "double_pentagon", "mirror_square", "klein_bottle",
+                                 "cone_pi", "affine_two_rooms", "l_shape_prism", "cylinder"}) {
+    SCOPED_TRACE(name);
+    const std::string file = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/" + name + ".json";
+    const Scene scene = load_scene(file);
+    Camera c = scene.camera;
+    int crossings = 0;
+    for (const auto& w : walks) {
+      const WalkResult r = walk(scene, c, w[0], w[1], w[2]);
+      c = r.camera;
+      crossings += r.crossings;
+    }
+    const auto exported = test::run_flatmarch({"export-web", file, "-o", dir + "/" + name, "-q"});
+    ASSERT_EQ(exported.exit_code, 0) << exported.err;
+    const auto page =
+        test::run_process({browser, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom",
+                           "file://" + dir + "/" + name + "/index.html?walk=" + arg},
+                          120.0);
+    const size_t at = page.out.find("<title>flatmarch: walked ");
+    ASSERT_NE(at, std::string::npos) << page.out.substr(0, 300);
+    const size_t from = at + std::string("<title>flatmarch: walked ").size();
+    const auto got =
+        nlohmann::json::parse(page.out.substr(from, page.out.find("</title>", from) - from));
+    EXPECT_EQ(got["polygon"].get<int>(), c.polygon);
+    EXPECT_EQ(got["crossings"].get<int>(), crossings);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(got["position"][k].get<double>(), c.position[k], 1e-5) << k;
+    EXPECT_NEAR(std::remainder(got["yaw_deg"].get<double>() - c.yaw_deg, 360.0), 0.0, 1e-5);
+    total += crossings;
+  }
+  EXPECT_GT(total, 10);  // the walks crossed gluings (mirror_square has none: it slides)
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
