@@ -14,6 +14,7 @@
 #include "cli/common.hpp"
 #include "kernels/compile.hpp"
 #include "kernels/scene_shader.hpp"
+#include "plan/floor_plan.hpp"
 #include "scene/load.hpp"
 #include "viewer/walk.hpp"
 
@@ -385,11 +386,6 @@ std::string replace_all(std::string s, const std::string& from, const std::strin
   return s;
 }
 
-// Text as HTML (for the title).
-std::string html_text(const std::string& s) {
-  return replace_all(replace_all(replace_all(s, "&", "&amp;"), "<", "&lt;"), ">", "&gt;");
-}
-
 json pair(Vec2 v) {
   return {v.x, v.y};
 }
@@ -460,7 +456,7 @@ std::string page(const Scene& scene, const MarchParams& params) {
                      {"shaders", shaders}};
   // In a script element "</" would end it early.
   const std::string text = replace_all(data.dump(), "</", "<\\/");
-  return replace_all(replace_all(kPage, "@TITLE@", html_text(scene.name)), "@DATA@", text);
+  return replace_all(replace_all(kPage, "@TITLE@", xml_escape(scene.name)), "@DATA@", text);
 }
 
 void write_file(const fs::path& file, const std::string& text) {
@@ -525,8 +521,8 @@ void add_export_web(CLI::App& app) {
           scenes.size() == 1 ? out / "index.html" : out / scene.name / "index.html";
       const std::string text = page(scene, o->params);
       write_file(file, text);
-      links += "<li><a href=\"" + html_text(scene.name) + "/index.html\">" + html_text(scene.name) +
-               "</a> " + html_text(scene.description) + "</li>\n";
+      links += "<li><a href=\"" + xml_escape(scene.name) + "/index.html\">" +
+               xml_escape(scene.name) + "</a> " + xml_escape(scene.description) + "</li>\n";
       if (!o->quiet)
         std::fprintf(stderr, "export-web: wrote %s (%s)\n", file.string().c_str(),
                      kilobytes(text.size()).c_str());

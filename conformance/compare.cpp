@@ -265,7 +265,6 @@ AovComparison compare_aovs(const Frame& got, const FrameTruth& truth, double sca
       ++c.ambiguous;
       continue;
     }
-    c.creases += bits != 0;
     const int hit = static_cast<int>(got.hit[px]), want = static_cast<int>(truth.frame.hit[px]);
     const int crossings = static_cast<int>(got.crossings[px]);
     const int want_crossings = static_cast<int>(truth.frame.crossings[px]);

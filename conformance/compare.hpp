@@ -106,7 +106,6 @@ double ks_statistic(const Channel& a, const Channel& b);
 // --- AOVs against the oracle's, on the pixels the ambiguity mask leaves decided.
 struct AovComparison {
   size_t pixels = 0, ambiguous = 0;  // ambiguous: the path undecided (kPathAmbiguity)
-  size_t creases = 0;                // decided, but the colour in doubt (kCrease alone)
   size_t hit_equal = 0;              // decided pixels whose hit is the oracle's
   size_t crossings_equal = 0;        // decided pixels whose crossings are the oracle's
   // t on the decided pixels that end as the oracle's, at a surface or escaping: |t - t'| against
