@@ -18,11 +18,6 @@ namespace flatmarch {
 
 namespace {
 
-constexpr std::array<std::pair<Method, const char*>, 4> kMethods{{{Method::sphere, "sphere"},
-                                                                  {Method::relaxed, "relaxed"},
-                                                                  {Method::analytic, "analytic"},
-                                                                  {Method::oracle, "oracle"}}};
-
 constexpr std::array<std::pair<EventKind, const char*>, 11> kEventKinds{
     {{EventKind::gluing, "gluing"},
      {EventKind::mirror, "mirror"},
@@ -43,27 +38,8 @@ const char* name_of(const std::array<std::pair<E, const char*>, N>& table, E val
   return "?";
 }
 
-template <typename E, size_t N>
-std::optional<E> value_of(const std::array<std::pair<E, const char*>, N>& table,
-                          const std::string& name) {
-  for (const auto& [v, n] : table)
-    if (name == n) return v;
-  return std::nullopt;
-}
-
 }  // namespace
 
-const char* to_string(Method m) {
-  return name_of(kMethods, m);
-}
-std::optional<Method> parse_method(const std::string& name) {
-  return value_of(kMethods, name);
-}
-std::string method_names() {
-  std::string names;
-  for (const auto& [m, name] : kMethods) names += (names.empty() ? "" : ", ") + std::string(name);
-  return names;
-}
 const char* to_string(EventKind k) {
   return name_of(kEventKinds, k);
 }

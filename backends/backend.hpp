@@ -16,11 +16,6 @@
 
 namespace flatmarch {
 
-const char* to_string(Method m);
-std::optional<Method> parse_method(const std::string& name);
-// Every method's name, in order, joined by ", " (for help texts and errors).
-std::string method_names();
-
 // One ray, in the coordinates of `polygon` (ignored when `from` lies outside every wall band).
 struct Ray {
   int polygon = 0;

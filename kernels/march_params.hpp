@@ -2,6 +2,8 @@
 #pragma once
 
 #include <array>
+#include <optional>
+#include <string>
 
 namespace flatmarch {
 
@@ -15,6 +17,11 @@ enum class Precision { f32, f64 };
 // Method::oracle alone). Every list of methods in the project is read from here.
 inline constexpr std::array<Method, 3> kKernelMethods{Method::sphere, Method::relaxed,
                                                       Method::analytic};
+
+const char* to_string(Method m);
+std::optional<Method> parse_method(const std::string& name);
+// Every method's name, in order, joined by ", " (for help texts and errors).
+std::string method_names();
 
 struct MarchParams {
   Method method = Method::sphere;

@@ -58,14 +58,35 @@ uniform vec2 u_size;
 uniform vec2 u_rows;  // the pixel's row from the top is u_rows.x + u_rows.y * gl_FragCoord.y
 
 layout(location = 0) out vec4 out_color;
+#ifndef FLATMARCH_CANVAS
 layout(location = 1) out vec4 out_aov;
+#endif
+#ifdef FLATMARCH_TRACE_PICK
+layout(location = 2) out vec4 out_at;
+#endif
+
+#ifdef FLATMARCH_CANVAS
+// The sRGB transfer function (IEC 61966-2-1), as OpenImageIO encodes the PNGs of `render`.
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+#endif
 
 void main() {
-#ifdef FLATMARCH_TRACE
+#if defined(FLATMARCH_TRACE)
   Ray r = march(u_polygon, u_from, u_forward);
   trace_steps = r.steps;
   out_color = vec4(0.0);
   out_aov = vec4(0.0);
+#elif defined(FLATMARCH_TRACE_PICK)
+  // Fragment k (row by row) marches the probe ray and keeps its k-th event: the event, then
+  // (to_edge, object, the ray's steps, its event count), then the point and t.
+  trace_pick = int(gl_FragCoord.y) * int(u_size.x) + int(gl_FragCoord.x);
+  Ray r = march(u_polygon, u_from, u_forward);
+  out_color = vec4(picked_event.kind);
+  out_aov = vec4(vec2(picked_event.more.xy), float(r.steps), float(event_count));
+  out_at = picked_event.at;
 #else
   // DESIGN.md section 2: x from the left, y from the top, through the pixel's centre
   // (gl_FragCoord is at the centre). The image's top row is OpenGL's top row (u_rows = (height,
@@ -74,8 +95,12 @@ void main() {
   float u = (2.0 * p.x / u_size.x - 1.0) * u_scale.x;
   float v = (1.0 - 2.0 * p.y / u_size.y) * u_scale.y;
   Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));
+#ifdef FLATMARCH_CANVAS
+  out_color = vec4(srgb(shade(r)), 1.0);
+#else
   out_color = vec4(shade(r), 1.0);
   out_aov = vec4(float(r.steps), float(r.crossings), float(r.hit), r.t);
+#endif
 #endif
 }
 )glsl";
@@ -191,47 +216,22 @@ std::string scene_compute_shader(const SceneTables<float>& tables, bool trace, b
 
 namespace {
 
-// The web page's main(): as kFragmentMain, but the colour sRGB-encoded for the canvas, and no
-// AOV target (a canvas has one colour buffer).
-const char* const kWebFragmentMain = R"glsl(
-uniform int u_polygon;
-uniform vec3 u_from;
-uniform vec3 u_forward;
-uniform vec3 u_right;
-uniform vec3 u_up;
-uniform vec2 u_scale;
-uniform vec2 u_size;
-
-layout(location = 0) out vec4 out_color;
-
-// The sRGB transfer function (IEC 61966-2-1), as OpenImageIO encodes the PNGs of `render`.
-vec3 srgb(vec3 c) {
-  c = clamp(c, 0.0, 1.0);
-  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
-
-void main() {
-  // DESIGN.md section 2: x from the left, y from the top (a canvas's row 0 is its top row).
-  vec2 p = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);
-  float u = (2.0 * p.x / u_size.x - 1.0) * u_scale.x;
-  float v = (1.0 - 2.0 * p.y / u_size.y) * u_scale.y;
-  Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));
-  out_color = vec4(srgb(shade(r)), 1.0);
-}
-)glsl";
-
-// GLSL ES 3.00 (WebGL2) in place of the first line's desktop version.
-std::string as_glsl_es(const std::string& source) {
+// GLSL ES 3.00 (WebGL2) in place of the first line's desktop version, with `defines`.
+std::string as_glsl_es(const std::string& source, const std::string& defines) {
   const size_t end = source.find('\n');
-  return "#version 300 es\nprecision highp float;\nprecision highp int;\n" + source.substr(end + 1);
+  return "#version 300 es\n" + defines + "precision highp float;\nprecision highp int;\n" +
+         source.substr(end + 1);
 }
 
 }  // namespace
 
-std::string web_fragment_shader(const SceneTables<float>& tables) {
+std::string web_fragment_shader(const SceneTables<float>& tables, WebShader kind) {
+  const char* const defines[] = {"#define FLATMARCH_CANVAS\n", "",
+                                 "#define FLATMARCH_TRACE_PICK\n"};
   // Plain global arrays, not constants: SwiftShader (Chromium's WebGL without a GPU) crashes its
   // GPU process on a struct read from a constant array at an index known only at run time.
-  return as_glsl_es(shader_source(tables.features, baked_tables(tables, false)) + kWebFragmentMain);
+  return as_glsl_es(shader_source(tables.features, baked_tables(tables, false)) + kFragmentMain,
+                    defines[static_cast<int>(kind)]);
 }
 
 const char* const kWebVertexShader = R"glsl(#version 300 es

@@ -34,10 +34,19 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays 
 std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace = false,
                                   bool from_band = false);
 
-// The web page's fragment shader (`flatmarch export-web`): the same kernel and baked tables in
-// GLSL ES 3.00 for WebGL2, with the uniforms of scene_fragment_shader but u_rows, and one output,
-// the colour sRGB-encoded for a canvas. Every ray may start outside the band.
-std::string web_fragment_shader(const SceneTables<float>& tables);
+// The web page's fragment shaders (web/page.hpp): scene_fragment_shader's kernel, baked tables,
+// uniforms and main() in GLSL ES 3.00 for WebGL2. Every ray may start outside the band.
+enum class WebShader {
+  canvas,    // one output: the colour sRGB-encoded, for the page's canvas
+  readback,  // as scene_fragment_shader's: linear colour and the AOVs, for float targets
+  // WebGL2 has no storage buffers: a frame of fragments, fragment k (row by row, from the
+  // bottom-left) marching the probe ray (u_polygon, u_from, direction u_forward) and writing its
+  // k-th event to three float targets: (kind, polygon, edge, to_polygon), (to_edge, object, the
+  // ray's steps, its count of events), (the point, t). Past the last event, kind is -1.
+  trace,
+};
+std::string web_fragment_shader(const SceneTables<float>& tables,
+                                WebShader kind = WebShader::canvas);
 // Its vertex shader: one triangle over the viewport, drawn with 3 vertices and no attributes.
 extern const char* const kWebVertexShader;
 

@@ -1,0 +1,34 @@
+#include "kernels/march_params.hpp"
+
+#include <utility>
+
+namespace flatmarch {
+
+namespace {
+
+constexpr std::array<std::pair<Method, const char*>, 4> kMethods{{{Method::sphere, "sphere"},
+                                                                  {Method::relaxed, "relaxed"},
+                                                                  {Method::analytic, "analytic"},
+                                                                  {Method::oracle, "oracle"}}};
+
+}  // namespace
+
+const char* to_string(Method m) {
+  for (const auto& [v, name] : kMethods)
+    if (v == m) return name;
+  return "?";
+}
+
+std::optional<Method> parse_method(const std::string& name) {
+  for (const auto& [v, n] : kMethods)
+    if (name == n) return v;
+  return std::nullopt;
+}
+
+std::string method_names() {
+  std::string names;
+  for (const auto& [m, name] : kMethods) names += (names.empty() ? "" : ", ") + std::string(name);
+  return names;
+}
+
+}  // namespace flatmarch
