@@ -13,6 +13,7 @@
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/simd.hpp"
 #include "backends/vulkan/vulkan.hpp"
+#include "backends/webgl/webgl.hpp"
 
 namespace flatmarch {
 
@@ -116,6 +117,11 @@ std::vector<BackendEntry>& registry() {
                    {"--vk-staging", &BackendOptions::vk_staging,
                     "read frames back through a staging buffer, as on a discrete GPU, even where "
                     "the device's memory is host-visible"}}},
+      {.name = "webgl",
+       .make = [](const BackendOptions& o) { return std::make_unique<WebGlBackend>(o); },
+       .options = {{"--device", &BackendOptions::device,
+                    "gpu or swiftshader (default: Chromium's choice, a GPU where it can "
+                    "use one, else SwiftShader)"}}},
   };
   return entries;
 }

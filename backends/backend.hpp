@@ -191,6 +191,10 @@ class Backend {
 
   virtual Frame render(const Scene& scene, const Camera& camera, int width, int height,
                        const MarchParams& params, const Progress& progress) const = 0;
+  // The time the last render() took as the backend measured it itself, where a clock around
+  // render() would count more than the frame (webgl: the browser's round trip); unset where the
+  // clock around render() is the measure. The benchmarks time frames by it when set.
+  virtual std::optional<double> last_frame_seconds() const { return std::nullopt; }
   // Follows one ray, recording at most `max_events` events.
   virtual Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
                       int max_events) const = 0;

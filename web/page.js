@@ -48,15 +48,18 @@ function program(name, source) {
 
 // Sets a program's camera uniforms for a w x h frame; `rows` as kernels/scene_shader.hpp says
 // (a canvas: [h, -1], its row 0 at the top; a read-back: [0, 1]).
+// A camera may bring its basis and scale made already (c.basis: forward, right, up, scale), as
+// the webgl backend does, with the values of the other backends' uniforms.
 function setCamera(u, c, w, h, rows) {
-  const { f, r, u: up } = basis(c);
   const t = Math.tan(c.fov_deg * Math.PI / 360);
+  const { f, r, u: up } = c.basis ? { f: c.basis.forward, r: c.basis.right, u: c.basis.up } : basis(c);
+  const scale = c.basis ? c.basis.scale : [(w / h) * t, t];
   gl.uniform1i(u.u_polygon, c.polygon);
   gl.uniform3fv(u.u_from, c.position);
   gl.uniform3fv(u.u_forward, f);
   gl.uniform3fv(u.u_right, r);
   gl.uniform3fv(u.u_up, up);
-  gl.uniform2f(u.u_scale, (w / h) * t, t);
+  gl.uniform2f(u.u_scale, scale[0], scale[1]);
   gl.uniform2f(u.u_size, w, h);
   gl.uniform2f(u.u_rows, rows[0], rows[1]);
 }
@@ -336,20 +339,7 @@ if (readback && gl) {
     return result;
   }
   window.flatmarchReadback = {
-    // The browser's WebGL: its version and renderer (the GPU, or the software rasteriser).
-    info() {
-      const debug = gl.getExtension("WEBGL_debug_renderer_info");
-      return {
-        version: gl.getParameter(gl.VERSION),
-        glsl: gl.getParameter(gl.SHADING_LANGUAGE_VERSION),
-        vendor: gl.getParameter(debug ? debug.UNMASKED_VENDOR_WEBGL : gl.VENDOR),
-        renderer: gl.getParameter(debug ? debug.UNMASKED_RENDERER_WEBGL : gl.RENDERER),
-        float_targets: !!floatTargets,
-        max_size: gl.getParameter(gl.MAX_TEXTURE_SIZE),
-        user_agent: navigator.userAgent,
-      };
-    },
-    // A w x h frame from camera `c` (as scene.camera): its linear colour (rgba) and AOVs (steps,
+    // A w x h frame from camera `c` (as scene.camera, or with c.basis): its linear colour (rgba) and AOVs (steps,
     // crossings, hit, t), rows from the top; `ms` is the page's own time for the draw and the
     // read-back of both targets (not the transfer to the driver).
     render(c, w, h) {
@@ -371,8 +361,8 @@ if (readback && gl) {
       const n = Math.max(1, count), w = Math.min(n, 1024), h = Math.ceil(n / w);
       bindTargets(w, h, 3);
       gl.useProgram(p);
-      setCamera(u, { polygon, position: from, yaw_deg: 0, pitch_deg: 0, fov_deg: 90 }, w, h, [0, 1]);
-      gl.uniform3fv(u.u_forward, dir);
+      setCamera(u, { polygon, position: from, basis: { forward: dir, right: [0, 0, 0], up: [0, 0, 0],
+                                                      scale: [1, 1] } }, w, h, [0, 1]);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
       return checked({ w, h, kind: base64(readTarget(0, w, h)), more: base64(readTarget(1, w, h)),
                        at: base64(readTarget(2, w, h)) });
