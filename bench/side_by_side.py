@@ -35,7 +35,7 @@ def main():
     args = parser.parse_args()
     first, second = args.backends
     cases = defaultdict(dict)  # (size, method, scene) -> {backend: ms}
-    pattern = re.compile(r"^(\w+)/(\w+)/(\w+)/(\d+x\d+)(?:/real_time)?$")
+    pattern = re.compile(r"^(\w+)/(\w+)/(\w+)/(\d+x\d+)(?:/(?:real|manual)_time)?$")
     for name, run in figures(args.json).items():
         m = pattern.match(name)
         if m:

@@ -119,7 +119,7 @@ void add_report(CLI::App& app) {
       "reports/baseline.json when this run was measured as it was, else why not. --previous\n"
       "adds the change per case since an earlier run.");
   struct Options {
-    std::vector<std::string> results, backends, scenes, methods;
+    std::vector<std::string> results, backends, skip_backends, scenes, methods;
     std::vector<std::string> galleries = {"scenes"};
     std::string out = "reports/out", size, conform_size = "160x90", sweep_size, sweep_backend;
     std::string baseline, write_baseline, previous, python = default_python();
@@ -140,6 +140,9 @@ void add_report(CLI::App& app) {
   cmd->add_option("--backend", o->backends,
                   "Backend to measure (repeat; default: " + joined(kernel_backend_names()) +
                       " — those unavailable here skipped with the reason)");
+  cmd->add_option("--skip-backend", o->skip_backends,
+                  "Leave this backend out of the default list (repeat; the regression gate leaves "
+                  "out webgl, whose every page a browser compiles for seconds on SwiftShader)");
   cmd->add_option("--scene", o->scenes, "Scene file or gallery name (repeat; default: all)");
   cmd->add_option("--gallery", o->galleries, "Folders of scenes")->capture_default_str();
   cmd->add_option("--method", o->methods, kernel_method_names() + " (repeat; default: all)");
@@ -194,6 +197,13 @@ void add_report(CLI::App& app) {
     r.matrix.backend_options = o->backend_options;
     r.matrix.methods = parse_methods(o->methods);
     if (!o->backends.empty()) r.matrix.backends = o->backends;
+    for (const std::string& b : o->skip_backends) {
+      const auto at = std::find(r.matrix.backends.begin(), r.matrix.backends.end(), b);
+      if (at == r.matrix.backends.end())
+        throw UsageError("--skip-backend: " + b + " is not among the backends measured (" +
+                         joined(r.matrix.backends) + ")");
+      r.matrix.backends.erase(at);
+    }
     for (const std::string& b : r.matrix.backends) make_kernel_backend(b, o->backend_options);
     std::tie(r.matrix.width, r.matrix.height) =
         parse_size("--size", o->size.empty() ? (o->full ? "640x360" : "256x144") : o->size);

@@ -61,7 +61,9 @@ nlohmann::json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions&
 nlohmann::json run_registered_benchmarks(const std::function<void(const std::string&)>& on_run);
 
 // Registers one timed case, BACKEND/METHOD/SCENE/WxH: frames of the scene's camera, after one
-// untimed frame (GPU backends compile the scene's program then); counters rays_per_s,
+// untimed frame (GPU backends compile the scene's program then), each frame timed by the
+// backend's own measure where it has one (Backend::last_frame_seconds: webgl's page), else by the
+// clock around render() (Google Benchmark's manual time); counters rays_per_s,
 // steps_mean, steps_p99, crossings_mean, out_of_steps and, for the SIMD backend, lane_utilisation,
 // steps_per_s, peak_steps_per_s and of_peak (simd_counters); a GPU backend's runs are labelled with
 // its device (device_label). `last`, when given, receives the last frame. Repetitions and min_time
