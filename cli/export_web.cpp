@@ -19,6 +19,21 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The page's floor-plan inset: the plan `flatmarch plan` draws, 320 pixels wide.
+web::FloorPlan floor_plan(const Scene& scene) {
+  PlanOptions options;
+  options.width = 320.0;
+  const PlanLayout layout(scene, options.width);
+  const Vec2 origin = layout.to_pixels(Vec2(0.0));
+  return {.svg = floor_plan_svg(scene, options),
+          .width = layout.width(),
+          .height = layout.height(),
+          .title_height = PlanLayout::kTitleHeight,
+          .origin_x = origin.x,
+          .origin_y = origin.y,
+          .scale = layout.to_pixels(1.0)};
+}
+
 void write_file(const fs::path& file, const std::string& text) {
   std::error_code error;
   fs::create_directories(file.parent_path(), error);
@@ -41,16 +56,19 @@ void add_export_web(CLI::App& app) {
       "Write each scene as a self-contained web page that marches it in the browser with WebGL2:\n"
       "the kernel's shader (kernels/march.glsl) in GLSL ES 3.00, specialised on the scene with "
       "its\n"
-      "tables baked in, one per method, and the scene's camera. Nothing is fetched when the page\n"
-      "opens: it works from a file, offline. Controls: drag or arrow keys to look, 1/2/3 for\n"
-      "sphere/relaxed/analytic, [ ] the field of view, - + the resolution, P a screenshot, H the\n"
-      "help line. The page takes ?frame=WxH to draw one frame of that size from the scene's "
-      "camera\n"
-      "(for comparisons with `flatmarch render`; &bench=N times N more and puts the median in\n"
-      "the title), ?method=NAME, and ?walk=F,R,U;... (walks, as the viewer's, whose end the\n"
-      "title then gives). W/A/S/D walk, E/Q up and down, carried through gluings as in the\n"
-      "viewer. One scene: OUT/index.html;\n"
-      "several: OUT/NAME/index.html each and OUT/index.html linking them.");
+      "tables baked in, one per method, the scene's camera and its floor plan. Nothing is fetched\n"
+      "when the page opens: it works from a file, offline. Controls, as the viewer's: W/A/S/D\n"
+      "walk and E/Q rise and sink (Shift: faster), carried through gluings as in the viewer; a\n"
+      "click locks the mouse to look (Esc frees it), or drag, or arrow keys; on a touch screen "
+      "one\n"
+      "finger drags to look and two drag to move; 1/2/3 sphere/relaxed/analytic; [ ] eps and ; '\n"
+      "offset by quarter decades (the shader recompiled); the wheel the field of view; - + the\n"
+      "resolution; M the floor-plan inset; P a screenshot; H the help line. The page takes\n"
+      "?frame=WxH to draw one frame of that size from the scene's camera (for comparisons with\n"
+      "`flatmarch render`; &bench=N times N more and puts the median in the title),\n"
+      "?method=NAME, ?keys=K,K,... (key presses first) and ?walk=F,R,U;... (walks, whose end the\n"
+      "title then gives). One scene: OUT/index.html; several: OUT/NAME/index.html each and\n"
+      "OUT/index.html linking them. The webgl backend runs these pages in headless Chromium.");
   struct Options {
     std::vector<std::string> scenes;
     std::string out, method = "analytic";
@@ -79,7 +97,7 @@ void add_export_web(CLI::App& app) {
     for (const Scene& scene : scenes) {
       const fs::path file =
           scenes.size() == 1 ? out / "index.html" : out / scene.name / "index.html";
-      const std::string text = web::page(scene, o->params);
+      const std::string text = web::page(scene, o->params, {.floor_plan = floor_plan(scene)});
       write_file(file, text);
       links += "<li><a href=\"" + xml_escape(scene.name) + "/index.html\">" +
                xml_escape(scene.name) + "</a> " + xml_escape(scene.description) + "</li>\n";

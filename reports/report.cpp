@@ -301,7 +301,8 @@ std::string describe_selection(const json& results, const std::string& type) {
     s += line;
     if (b.contains("device"))
       s += "  on " + b["device"]["name"].get<std::string>() +
-           (b["device"]["software"].get<bool>() ? " (software: a rasteriser on the CPU)" : "");
+           (b["device"]["software"].get<bool>() ? " (software: a rasteriser on the CPU)" : "") +
+           ", " + b["device"].value("driver", std::string("?"));
     s += "\n";
   }
   return s;

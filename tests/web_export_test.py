@@ -60,6 +60,13 @@ def main():
     if r.returncode != 0:
         print("export-web failed:", r.stderr)
         return 1
+    # Each page's size is reported.
+    for name in NAMES:
+        size = re.search(re.escape(os.path.join(name, "index.html")) + r" \((\d+) KB\)", r.stderr)
+        if not size:
+            failures.append(f"{name}: export-web did not report the page's size: {r.stderr}")
+        else:
+            print(f"{name}: {size.group(1)} KB")
     index = open(os.path.join(out, "index.html")).read()
     for name in NAMES:
         page = os.path.join(out, name, "index.html")
@@ -89,6 +96,29 @@ def main():
         print(f"{name}: {100 * share:.2f}% of the pixels within 3/255 of the opengl backend's")
         if share < 0.99:
             failures.append(f"{name}: only {100 * share:.2f}% of the pixels agree")
+    # The eps and offset keys: eight presses of ] take eps from 1e-4 to 1e-2 in quarter decades,
+    # carrying offset up to the first quarter decade above it, 2e-4 * 10^(7/4); the page's shader
+    # is then the opengl backend's at those parameters.
+    keyed = os.path.join(out, "keys.web.png")
+    run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+         f"--window-size={WIDTH},{HEIGHT}", f"--screenshot={keyed}",
+         "file://" + os.path.abspath(os.path.join(out, "torus", "index.html")) +
+         f"?frame={WIDTH}x{HEIGHT}&keys=" + ",".join("]" * 8)])
+    ref = os.path.join(out, "keys.gl.png")
+    run([flatmarch, "render", os.path.join(SCENES, "torus.json"), "--backend", "opengl",
+         "--size", f"{WIDTH}x{HEIGHT}", "--eps", "1e-2", "--offset", repr(2e-4 * 10 ** (7 / 4)),
+         "-o", ref, "-q"])
+    if os.path.exists(keyed) and os.path.exists(ref):
+        (_, web), (_, gl) = pixels(keyed), pixels(ref)
+        (_, plain) = pixels(os.path.join(out, "torus.web.png"))
+        same = sum(max(abs(a - b) for a, b in zip(p, q)) <= 3 for p, q in zip(web, gl)) / len(gl)
+        before = sum(max(abs(a - b) for a, b in zip(p, q)) <= 3 for p, q in zip(plain, gl)) / len(gl)
+        print(f"keys ]x8: {100 * same:.2f}% of the pixels as opengl's at eps 1e-2 "
+              f"(the page before the keys: {100 * before:.2f}%)")
+        if same < 0.99 or before >= same:
+            failures.append(f"keys ]x8: {100 * same:.2f}% agree with eps 1e-2, {100 * before:.2f}% before")
+    else:
+        failures.append("keys ]x8: no image")
     # Timed frames: ?bench=N puts the median frame time in the title.
     page = os.path.abspath(os.path.join(out, NAMES[0], "index.html"))
     dom = run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--dump-dom",

@@ -8,6 +8,7 @@
 
 #include "kernels/compile.hpp"
 #include "kernels/scene_shader.hpp"
+#include "viewer/controls.hpp"
 #include "viewer/walk.hpp"
 
 namespace flatmarch::web {
@@ -96,9 +97,21 @@ std::string page(const Scene& scene, const MarchParams& params, const PageOption
                {"method", to_string(params.method)},
                {"eps", params.eps},
                {"offset", params.offset},
+               {"eps_range", {viewer::kMinEps, viewer::kMaxEps}},
+               {"max_offset", viewer::kMaxOffset},
+               {"degrees_per_pixel", viewer::kDegreesPerPixel},
                {"walk", walk_data(scene)},
                {"vertex_shader", kernel::kWebVertexShader},
                {"shaders", shaders}};
+  if (options.floor_plan) {
+    const FloorPlan& f = *options.floor_plan;
+    data["floor_plan"] = {{"svg", f.svg},
+                          {"width", f.width},
+                          {"height", f.height},
+                          {"title_height", f.title_height},
+                          {"origin", {f.origin_x, f.origin_y}},
+                          {"scale", f.scale}};
+  }
   if (options.readback) {
     const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
     data["readback"] = {

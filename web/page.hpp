@@ -5,6 +5,7 @@
 // it; the webgl backend (backends/webgl) loads it in headless Chromium in read-back mode.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,16 @@
 #include "scene/scene.hpp"
 
 namespace flatmarch::web {
+
+// The floor-plan inset: the plan of `flatmarch plan` (plan/floor_plan.hpp, which the caller
+// draws: the backends' side of the project cannot link it) and how a point of the scene's plane
+// maps to its pixels: (origin_x + scale * x, origin_y - scale * y).
+struct FloorPlan {
+  std::string svg;
+  double width = 0.0, height = 0.0;  // its size in pixels
+  double title_height = 0.0;         // the title and summary at its top, left out of the inset
+  double origin_x = 0.0, origin_y = 0.0, scale = 1.0;
+};
 
 struct PageOptions {
   // The methods the page can switch between (a shader each); the page starts with the march
@@ -21,6 +32,8 @@ struct PageOptions {
   // colour and the AOVs into float targets and trace one probe ray, and offers them to a driver
   // as window.flatmarchReadback (web/page.js).
   bool readback = false;
+  // Drawn in a corner with the camera on it (M shows and hides it); none without.
+  std::optional<FloorPlan> floor_plan;
 };
 
 // The page's HTML, whole.

@@ -30,20 +30,53 @@ function compile(type, source) {
   return shader;
 }
 
+// eps and offset as the viewer steps them (viewer/controls.hpp): by quarter decades from the
+// export's values, eps within scene.eps_range, offset above eps and at most scene.max_offset.
+let epsSteps = 0, offsetSteps = 0;
+const quarterDecades = (start, steps) => start * Math.pow(10, steps / 4);
+const eps = () => quarterDecades(scene.eps, epsSteps);
+const offset = () => quarterDecades(scene.offset, offsetSteps);
+function stepEps(steps) {
+  const e = quarterDecades(scene.eps, epsSteps + steps);
+  if (e < scene.eps_range[0] || e > scene.eps_range[1]) return;
+  epsSteps += steps;
+  for (let k = 0; k < 64 && offset() <= eps(); ++k) ++offsetSteps;  // offset follows eps up
+}
+function stepOffset(steps) {
+  const o = quarterDecades(scene.offset, offsetSteps + steps);
+  if (o <= eps() || o > scene.max_offset) return;
+  offsetSteps += steps;
+}
+// A shader with other eps and offset: they are baked into its parameters' constant
+// (kernels/scene_shader.cpp, baked_params: method, max_steps, polygons, eps, offset, ...).
+function withParams(source, e, o) {
+  const glslFloat = (x) => x.toExponential(8);
+  return source.replace(/(const KernelParams params = KernelParams\(\s*[^,]+,\s*[^,]+,\s*[^,]+,\s*)[^,]+,\s*[^,]+,/,
+                        (all, head) => head + glslFloat(e) + ", " + glslFloat(o) + ",");
+}
+
 const programs = {};
-// A method's program (its shader in scene.shaders), or `source` under `name`.
+// A method's program (its shader in scene.shaders, with the eps and offset of the keys), or
+// `source` under `name`.
 function program(name, source) {
-  if (programs[name]) return programs[name];
+  if (!source && (epsSteps || offsetSteps)) {
+    const key = name + "@" + epsSteps + "," + offsetSteps;
+    if (!programs[key]) programs[key] = link(withParams(scene.shaders[name], eps(), offset()));
+    return programs[key];
+  }
+  if (!programs[name]) programs[name] = link(source || scene.shaders[name]);
+  return programs[name];
+}
+function link(fragment) {
   const p = gl.createProgram();
   gl.attachShader(p, compile(gl.VERTEX_SHADER, scene.vertex_shader));
-  gl.attachShader(p, compile(gl.FRAGMENT_SHADER, source || scene.shaders[name]));
+  gl.attachShader(p, compile(gl.FRAGMENT_SHADER, fragment));
   gl.linkProgram(p);
   if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error("link: " + gl.getProgramInfoLog(p));
   const u = {};
   for (const n of ["u_polygon", "u_from", "u_forward", "u_right", "u_up", "u_scale", "u_size", "u_rows"])
     u[n] = gl.getUniformLocation(p, n);
-  programs[name] = { p, u };
-  return programs[name];
+  return { p, u };
 }
 
 // Sets a program's camera uniforms for a w x h frame; `rows` as kernels/scene_shader.hpp says
@@ -103,10 +136,40 @@ function draw() {
 }
 
 function showHud(w, h) {
-  hud.innerHTML = "<b>" + scene.name + "</b> &middot; " + method + ", eps " + scene.eps +
-    ", offset " + scene.offset + " &middot; " + w + "&times;" + h + ", " + lastMs.toFixed(1) + " ms<br>" +
-    "W/A/S/D walk, E/Q up and down (Shift: faster) &middot; drag or arrow keys: look &middot; 1 sphere, 2 relaxed, 3 analytic &middot; [ ] field of view (" +
-    camera.fov_deg.toFixed(0) + "&deg;) &middot; - + resolution &middot; P screenshot &middot; H hide this";
+  hud.innerHTML = "<b>" + scene.name + "</b> &middot; " + method + ", eps " + eps().toPrecision(3) +
+    ", offset " + offset().toPrecision(3) + " &middot; " + w + "&times;" + h + ", " + lastMs.toFixed(1) + " ms<br>" +
+    "W/A/S/D walk, E/Q up and down (Shift: faster) &middot; click to look with the mouse (Esc frees it), " +
+    "or drag, or arrow keys &middot; touch: drag to look, two fingers to move &middot; " +
+    "1 sphere, 2 relaxed, 3 analytic &middot; [ ] eps, ; ' offset &middot; wheel: field of view (" +
+    camera.fov_deg.toFixed(0) + "&deg;) &middot; - + resolution &middot; M map &middot; P screenshot &middot; H hide this";
+  drawInset();
+}
+
+// The floor-plan inset (scene.floor_plan: the plan of `flatmarch plan`, its title left out) with
+// the camera on it, a dot and a line along its heading, as the viewer draws it.
+const inset = document.getElementById("inset");
+const plan = scene.floor_plan;
+let planImage = null;
+if (plan) {
+  planImage = new Image();
+  planImage.onload = () => drawInset();
+  planImage.src = "data:image/svg+xml;charset=utf-8," + encodeURIComponent(plan.svg);
+  inset.hidden = false;
+}
+function drawInset() {
+  if (!plan || inset.hidden || !planImage.complete) return;
+  const ratio = window.devicePixelRatio || 1;
+  const w = Math.round(Math.min(plan.width, inset.clientWidth || plan.width) * ratio);
+  const k = w / plan.width, h = Math.round((plan.height - plan.title_height) * k);
+  if (inset.width !== w || inset.height !== h) { inset.width = w; inset.height = h; }
+  const c = inset.getContext("2d");
+  c.drawImage(planImage, 0, plan.title_height, plan.width, plan.height - plan.title_height, 0, 0, w, h);
+  const x = (plan.origin[0] + plan.scale * camera.position[0]) * k;
+  const y = (plan.origin[1] - plan.scale * camera.position[1] - plan.title_height) * k;
+  const a = camera.yaw_deg * Math.PI / 180, reach = 14 * ratio;
+  c.strokeStyle = "#d00"; c.fillStyle = "#d00"; c.lineWidth = 2 * ratio;
+  c.beginPath(); c.moveTo(x, y); c.lineTo(x + reach * Math.cos(a), y - reach * Math.sin(a)); c.stroke();
+  c.beginPath(); c.arc(x, y, 4 * ratio, 0, 2 * Math.PI); c.fill();
 }
 
 let pending = false;
@@ -291,6 +354,39 @@ if (query.get("walk") !== null) {
   walked = JSON.stringify(
     { polygon: camera.polygon, position: camera.position, yaw_deg: camera.yaw_deg, crossings });
 }
+// A key press as the viewer takes it (W/A/S/D and E/Q one stride each); whether it was one.
+function press(e) {
+  const keys = {
+    ArrowLeft: () => look(5, 0), ArrowRight: () => look(-5, 0),
+    ArrowUp: () => look(0, 5), ArrowDown: () => look(0, -5),
+    w: () => walk(camera, stride(e), 0, 0), s: () => walk(camera, -stride(e), 0, 0),
+    d: () => walk(camera, 0, stride(e), 0), a: () => walk(camera, 0, -stride(e), 0),
+    e: () => walk(camera, 0, 0, stride(e)), q: () => walk(camera, 0, 0, -stride(e)),
+    "1": () => setMethod("sphere"), "2": () => setMethod("relaxed"), "3": () => setMethod("analytic"),
+    "[": () => stepEps(-1), "]": () => stepEps(1),
+    ";": () => stepOffset(-1), "'": () => stepOffset(1),
+    m: () => { inset.hidden = !plan || !inset.hidden; }, M: () => { inset.hidden = !plan || !inset.hidden; },
+    "-": () => { renderScale = Math.max(0.125, renderScale / 2); },
+    "+": () => { renderScale = Math.min(2, renderScale * 2); },
+    "=": () => { renderScale = Math.min(2, renderScale * 2); },
+    p: screenshot, P: screenshot,
+    h: () => { hud.hidden = !hud.hidden; }, H: () => { hud.hidden = !hud.hidden; },
+  };
+  const key = e.key.length === 1 && /[wasdeq]/i.test(e.key) ? e.key.toLowerCase() : e.key;
+  if (!keys[key]) return false;
+  keys[key]();
+  return true;
+}
+function setMethod(name) {
+  if (scene.shaders[name]) method = name;  // a page exported with its shader
+}
+// What the controls have set, for tests that drive the page (tests/web_page_test.cpp).
+window.flatmarchState = () => ({ camera, method, eps: eps(), offset: offset(),
+                                 inset: plan ? !inset.hidden : null });
+// ?keys=K,K,...: these key presses first (tests: `]` raises eps a quarter decade).
+for (const key of (query.get("keys") || "").split(",").filter((k) => k))
+  press({ key, shiftKey: false });
+
 // Read-back mode (web/page.hpp, PageOptions::readback): the page opened with ?readback draws
 // nothing by itself and offers window.flatmarchReadback to a driver (the webgl backend,
 // backends/webgl, through the DevTools protocol). Frames go to float targets (WebGL2's
@@ -387,32 +483,55 @@ if (readback) {
       times[Math.floor(times.length / 2)].toFixed(3) + " ms over " + bench + " frames" : "");
   } catch (e) { fail(String(e.message || e)); }
 } else if (gl) {
+  // The mouse: a click locks the pointer and then it looks, as in the viewer (Esc frees it);
+  // where the lock is refused, dragging looks. Touch: one finger drags to look, two drag to move
+  // (up the screen forward, sideways to the side).
+  const perPixel = scene.degrees_per_pixel;
+  const touches = new Map();  // pointerId -> [x, y]
+  const locked = () => document.pointerLockElement === canvas;
   let drag = null;
-  canvas.addEventListener("pointerdown", (e) => { drag = [e.clientX, e.clientY]; canvas.setPointerCapture(e.pointerId); });
-  canvas.addEventListener("pointerup", () => { drag = null; });
-  canvas.addEventListener("pointermove", (e) => {
-    if (!drag) return;
-    look(-0.2 * (e.clientX - drag[0]), -0.2 * (e.clientY - drag[1]));
-    drag = [e.clientX, e.clientY];
+  const centroid = () => {
+    let x = 0, y = 0;
+    for (const [px, py] of touches.values()) { x += px; y += py; }
+    return [x / touches.size, y / touches.size];
+  };
+  canvas.addEventListener("pointerdown", (e) => {
+    if (e.pointerType === "touch") {
+      touches.set(e.pointerId, [e.clientX, e.clientY]);
+    } else if (!locked()) {
+      drag = [e.clientX, e.clientY];
+      if (canvas.requestPointerLock) {
+        const request = canvas.requestPointerLock();
+        if (request && request.catch) request.catch(() => {});  // refused: dragging looks
+      }
+    }
+    canvas.setPointerCapture(e.pointerId);
   });
+  const release = (e) => { touches.delete(e.pointerId); drag = null; };
+  canvas.addEventListener("pointerup", release);
+  canvas.addEventListener("pointercancel", release);
+  canvas.addEventListener("pointermove", (e) => {
+    if (e.pointerType === "touch") {
+      if (!touches.has(e.pointerId)) return;
+      const before = centroid(), one = touches.size === 1;
+      touches.set(e.pointerId, [e.clientX, e.clientY]);
+      const after = centroid(), dx = after[0] - before[0], dy = after[1] - before[1];
+      if (one) look(-2 * perPixel * dx, -2 * perPixel * dy);
+      else if (touches.size === 2) { walk(camera, -dy * W.scale / 200, dx * W.scale / 200, 0); redraw(); }
+    } else if (locked()) {
+      look(-perPixel * e.movementX, -perPixel * e.movementY);
+    } else if (drag) {
+      look(-2 * perPixel * (e.clientX - drag[0]), -2 * perPixel * (e.clientY - drag[1]));
+      drag = [e.clientX, e.clientY];
+    }
+  });
+  canvas.addEventListener("wheel", (e) => {
+    camera.fov_deg = Math.max(10, Math.min(150, camera.fov_deg + (e.deltaY > 0 ? 5 : -5)));
+    redraw();
+    e.preventDefault();
+  }, { passive: false });
   window.addEventListener("keydown", (e) => {
-    const keys = {
-      ArrowLeft: () => look(5, 0), ArrowRight: () => look(-5, 0),
-      ArrowUp: () => look(0, 5), ArrowDown: () => look(0, -5),
-      w: () => walk(camera, stride(e), 0, 0), s: () => walk(camera, -stride(e), 0, 0),
-      d: () => walk(camera, 0, stride(e), 0), a: () => walk(camera, 0, -stride(e), 0),
-      e: () => walk(camera, 0, 0, stride(e)), q: () => walk(camera, 0, 0, -stride(e)),
-      "1": () => { method = "sphere"; }, "2": () => { method = "relaxed"; }, "3": () => { method = "analytic"; },
-      "[": () => { camera.fov_deg = Math.max(10, camera.fov_deg - 5); },
-      "]": () => { camera.fov_deg = Math.min(150, camera.fov_deg + 5); },
-      "-": () => { renderScale = Math.max(0.125, renderScale / 2); },
-      "+": () => { renderScale = Math.min(2, renderScale * 2); },
-      "=": () => { renderScale = Math.min(2, renderScale * 2); },
-      p: screenshot, P: screenshot,
-      h: () => { hud.hidden = !hud.hidden; }, H: () => { hud.hidden = !hud.hidden; },
-    };
-    const key = e.key.length === 1 && /[wasdeq]/i.test(e.key) ? e.key.toLowerCase() : e.key;
-    if (keys[key]) { keys[key](); redraw(); e.preventDefault(); }
+    if (press(e)) { redraw(); e.preventDefault(); }
   });
   window.addEventListener("resize", redraw);
   redraw();

@@ -98,6 +98,12 @@ void check_precision(const MarchParams& params) {
         "f64)");
 }
 
+// "Chrome/156.0.8078.108" as "Chrome 156.0.8078.108 (headless)": the browser, as a driver.
+std::string browser_name(std::string product) {
+  if (const size_t slash = product.find('/'); slash != std::string::npos) product[slash] = ' ';
+  return product + " (headless)";
+}
+
 [[noreturn]] void unavailable(const std::string& why) {
   throw std::runtime_error("the webgl backend is unavailable: " + why);
 }
@@ -204,7 +210,7 @@ std::optional<DeviceInfo> WebGlBackend::device() const {
   return DeviceInfo{.name = renderer,
                     .type = software ? "CPU" : "GPU",
                     .api = info.value("version", std::string()),
-                    .driver = session_->browser->product(),
+                    .driver = browser_name(session_->browser->product()),
                     .platform = "headless Chromium",
                     .software = software};
 }
