@@ -24,7 +24,6 @@
 #include "backends/vulkan/vulkan.hpp"
 #include "bench/gallery.hpp"
 #include "bench/peer_app.hpp"
-#include "interop/peer_import.hpp"
 
 namespace flatmarch::bench {
 
@@ -74,32 +73,6 @@ void app_frame(benchmark::State& state, PeerApp* app, std::string id, std::strin
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
   }
-}
-
-// The app's benchmark views: its geometry file (in tests/data/peer-geometries, and its shader's
-// name in the app) and ours.
-struct PeerView {
-  const char* id;
-  const char* name;
-};
-constexpr PeerView kPeerViews[] = {{"L_shape", "l_shape"},
-                                   {"DoublePentagonTranslation", "double_pentagon"},
-                                   {"torus", "torus"},
-                                   {"L_shapePrism", "l_shape_prism"},
-                                   {"equilateralTriangle", "equilateral_triangle"},
-                                   {"irrationalTriangle", "triangle_1rad"},
-                                   {"cube", "cube"}};
-
-// The app's view: from its start point + (0.5, 0, 0.5), looking along normalize(1, 0, 0.3) in its
-// coordinates (y up). The importer maps its (x, y, z) to our (x, z, y + wall height) and its
-// field of view to ours, so the view is the scene's camera moved by (0.5, 0.5, 0) and turned to
-// yaw atan2(0.3, 1), level. (Our image is the app's mirrored left to right: the same rays.)
-Camera peer_camera(const Scene& scene) {
-  Camera camera = scene.camera;
-  camera.position += Vec3(0.5, 0.5, 0.0);
-  camera.yaw_deg = glm::degrees(std::atan2(0.3, 1.0));
-  camera.pitch_deg = 0.0;
-  return camera;
 }
 
 }  // namespace flatmarch::bench
@@ -153,10 +126,7 @@ int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Scene>> peers;
   const bench::Size peer_size{640, 360};
   for (const bench::PeerView& view : bench::kPeerViews) {
-    const std::string file = std::string(view.id) + ".json";
-    const PeerImport imported = import_peer_file(std::filesystem::path(FLATMARCH_SOURCE_DIR) /
-                                                 "tests" / "data" / "peer-geometries" / file);
-    peers.push_back(std::make_unique<Scene>(scene_from_json(imported.scene, file)));
+    peers.push_back(std::make_unique<Scene>(bench::peer_scene(view)));
     if (app)
       benchmark::RegisterBenchmark(("peer/app/" + std::string(view.name)).c_str(), bench::app_frame,
                                    app.get(), std::string(view.id), std::string(view.name),

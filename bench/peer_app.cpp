@@ -1,5 +1,6 @@
 #include "bench/peer_app.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -8,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/opengl/gl_kernel.hpp"
+#include "interop/peer_import.hpp"
+#include "scene/load.hpp"
 
 namespace flatmarch::bench {
 
@@ -34,12 +37,42 @@ struct PeerApp::Program {
   ~Program() { gl.DeleteProgram(program); }
 };
 
-PeerApp::PeerApp(const std::filesystem::path& folder, const std::string& device) : folder_(folder) {
+Scene peer_scene(const PeerView& view) {
+  const std::string file = std::string(view.id) + ".json";
+  const PeerImport imported = import_peer_file(std::filesystem::path(FLATMARCH_SOURCE_DIR) /
+                                               "tests" / "data" / "peer-geometries" / file);
+  return scene_from_json(imported.scene, file);
+}
+
+Camera peer_camera(const Scene& scene) {
+  Camera camera = scene.camera;
+  camera.position += Vec3(0.5, 0.5, 0.0);
+  camera.yaw_deg = glm::degrees(std::atan2(0.3, 1.0));
+  camera.pitch_deg = 0.0;
+  return camera;
+}
+
+AppView app_view(glm::vec3 start) {
+  return {start + glm::vec3(0.5f, 0.0f, 0.5f), glm::normalize(glm::vec3(1.0f, 0.0f, 0.3f)),
+          glm::vec3(0.0f, 1.0f, 0.0f)};
+}
+
+std::map<std::string, glm::vec3> app_starts(const std::filesystem::path& folder) {
+  std::map<std::string, glm::vec3> starts;
   const nlohmann::json meta = nlohmann::json::parse(read(folder / "meta.json"));
   for (const auto& [id, m] : meta.items()) {
     const auto p = m.value("initialPosition", std::vector<float>{0.0f, 1.0f, 0.0f});
-    start_[id] = glm::vec3(p.at(0), p.at(1), p.at(2));
+    starts[id] = glm::vec3(p.at(0), p.at(1), p.at(2));
   }
+  return starts;
+}
+
+std::string app_shader(const std::filesystem::path& folder, const std::string& id) {
+  return read(folder / (id + ".frag"));
+}
+
+PeerApp::PeerApp(const std::filesystem::path& folder, const std::string& device)
+    : folder_(folder), start_(app_starts(folder)) {
   context_ = gl::make_context(device, gl::Profile::compatibility);
   const gl::Context::Current current(*context_);
   const gl::Api& gl = context_->api();
@@ -72,7 +105,7 @@ PeerApp::Program& PeerApp::program(const std::string& id) {
   if (!p) {
     const gl::Api& gl = context_->api();
     const GLuint program =
-        gl::link_program(gl, kVertexShader, "#version 120\n" + read(folder_ / (id + ".frag")));
+        gl::link_program(gl, kVertexShader, "#version 120\n" + app_shader(folder_, id));
     // Made in place: a temporary Program would delete the GL program as it goes.
     p.reset(new Program{gl, program, gl.GetUniformLocation(program, "iResolution"),
                         gl.GetUniformLocation(program, "iTime"),
@@ -103,14 +136,13 @@ void PeerApp::frame(const std::string& id, int width, int height) {
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
   const Program& p = program(id);
-  const glm::vec3 from = start_[id] + glm::vec3(0.5f, 0.0f, 0.5f);
-  const glm::vec3 front = glm::normalize(glm::vec3(1.0f, 0.0f, 0.3f));
+  const AppView view = app_view(start_[id]);
   gl.UseProgram(p.program);
   gl.Uniform2f(p.resolution, static_cast<float>(width), static_cast<float>(height));
   gl.Uniform1f(p.time, 0.0f);
-  gl.Uniform3f(p.position, from.x, from.y, from.z);
-  gl.Uniform3f(p.front, front.x, front.y, front.z);
-  gl.Uniform3f(p.up, 0.0f, 1.0f, 0.0f);
+  gl.Uniform3f(p.position, view.from.x, view.from.y, view.from.z);
+  gl.Uniform3f(p.front, view.front.x, view.front.y, view.front.z);
+  gl.Uniform3f(p.up, view.up.x, view.up.y, view.up.z);
   gl.Viewport(0, 0, width, height);
   gl.BindVertexArray(vertex_array_);
   gl.DrawArrays(GL_TRIANGLES, 0, 3);

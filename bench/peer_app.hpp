@@ -11,8 +11,42 @@
 #include <glm/glm.hpp>
 
 #include "backends/opengl/context.hpp"
+#include "scene/scene.hpp"
 
 namespace flatmarch::bench {
+
+// The app's benchmark views: its geometry file (in tests/data/peer-geometries, and its shader's
+// name in the app) and ours.
+struct PeerView {
+  const char* id;
+  const char* name;
+};
+inline constexpr PeerView kPeerViews[] = {{"L_shape", "l_shape"},
+                                          {"DoublePentagonTranslation", "double_pentagon"},
+                                          {"torus", "torus"},
+                                          {"L_shapePrism", "l_shape_prism"},
+                                          {"equilateralTriangle", "equilateral_triangle"},
+                                          {"irrationalTriangle", "triangle_1rad"},
+                                          {"cube", "cube"}};
+// A view's geometry imported as our scene (interop/peer_import.hpp).
+Scene peer_scene(const PeerView& view);
+
+// The app's view: from its start point + (0.5, 0, 0.5), looking along normalize(1, 0, 0.3) in its
+// coordinates (y up). The importer maps its (x, y, z) to our (x, z, y + wall height) and its
+// field of view to ours, so the view is the scene's camera moved by (0.5, 0.5, 0) and turned to
+// yaw atan2(0.3, 1), level. (Our image is the app's mirrored left to right: the same rays.)
+Camera peer_camera(const Scene& scene);
+
+// The same view as the app's shader takes it: its uniforms rayMarchCamPos, rayMarchCamFront and
+// rayMarchCamUp, from the app's start point.
+struct AppView {
+  glm::vec3 from, front, up;
+};
+AppView app_view(glm::vec3 start);
+// The app's start points (initialPosition, default (0, 1, 0)) by id, from FOLDER/meta.json.
+std::map<std::string, glm::vec3> app_starts(const std::filesystem::path& folder);
+// FOLDER/ID.frag, the app's shader of a geometry, as it comes (GLSL without a version line).
+std::string app_shader(const std::filesystem::path& folder, const std::string& id);
 
 class PeerApp {
  public:

@@ -176,5 +176,25 @@ TEST_F(WebPage, MShowsAndHidesTheFloorPlan) {
   EXPECT_TRUE(state()["inset"].get<bool>());
 }
 
+// No Chromium: the webgl backend is unavailable, and a command that needs it exits 3 saying why.
+TEST(WebGlCli, WithoutChromiumExits3AndSaysWhy) {
+  const std::string out = test::make_temp_dir() + "/x.png";
+  const std::string scene = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
+  auto r = test::run_process({"env", "FLATMARCH_CHROMIUM=/no/such/chromium", FLATMARCH_BINARY,
+                              "render", scene, "--backend", "webgl", "-o", out});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("webgl is unavailable here: cannot run /no/such/chromium"),
+            std::string::npos)
+      << r.err;
+  r = test::run_process(
+      {"env", "PATH=/nowhere", FLATMARCH_BINARY, "render", scene, "--backend", "webgl", "-o", out});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("no Chromium found"), std::string::npos) << r.err;
+  r = test::run_process({FLATMARCH_BINARY, "render", scene, "--backend", "webgl", "--device",
+                         "no such device", "-o", out});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("--device is one of gpu, swiftshader"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace flatmarch

@@ -119,21 +119,51 @@ function size() {
 
 let lastMs = 0;
 const probe = new Uint8Array(4);
-function draw() {
-  const [w, h] = size();
+// Draws a frame of `prog` on the canvas at w x h, `set` setting its uniforms, and returns its
+// milliseconds: a one-pixel read waits for it (gl.finish does not, in a browser).
+function drawFrame(prog, set, w, h) {
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
-  const { p, u } = program(method);
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   gl.viewport(0, 0, w, h);
-  gl.useProgram(p);
-  setCamera(u, camera, w, h, [h, -1]);
+  gl.useProgram(prog.p);
+  set(prog.u);
   const start = performance.now();
   gl.drawArrays(gl.TRIANGLES, 0, 3);
-  // A one-pixel read waits for the frame (gl.finish does not, in a browser): its time is honest.
   gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, probe);
-  lastMs = performance.now() - start;
+  return performance.now() - start;
+}
+
+function draw() {
+  const [w, h] = size();
+  lastMs = drawFrame(program(method), (u) => setCamera(u, camera, w, h, [h, -1]), w, h);
   showHud(w, h);
 }
+
+// Times n frames on the canvas at w x h, as a visitor sees them (benchmarks:
+// bench/web_bench.cpp): the page's shader of `method` from camera `c`, or `fragment`, another
+// GLSL ES 3.00 fragment shader (the original app's) under the page's vertex shader, with
+// `uniforms` (name -> numbers). Returns each frame's milliseconds; the first call compiles.
+window.flatmarchTimeFrames = ({ method: m = method, camera: c = camera, fragment, uniforms, w, h, n = 1 }) => {
+  document.body.classList.add("frame");
+  let prog, set;
+  if (fragment) {
+    prog = program("fragment:" + fragment, fragment);
+    const setters = [gl.uniform1fv, gl.uniform2fv, gl.uniform3fv, gl.uniform4fv];
+    set = () => {
+      for (const [name, v] of Object.entries(uniforms || {}))
+        setters[v.length - 1].call(gl, gl.getUniformLocation(prog.p, name), v);
+    };
+  } else {
+    if (!scene.shaders[m]) throw new Error("this page has no shader for " + m);
+    prog = program(m);
+    set = (u) => setCamera(u, c, w, h, [h, -1]);
+  }
+  const times = [];
+  for (let k = 0; k < n; ++k) times.push(drawFrame(prog, set, w, h));
+  const error = gl.getError();
+  if (error !== gl.NO_ERROR) throw new Error("WebGL error " + error);
+  return times;
+};
 
 function showHud(w, h) {
   hud.innerHTML = "<b>" + scene.name + "</b> &middot; " + method + ", eps " + eps().toPrecision(3) +

@@ -67,6 +67,17 @@ std::optional<std::string> find_chromium() {
   return std::nullopt;
 }
 
+std::vector<std::string> device_flags(const std::string& device) {
+  if (device.empty()) return {"--enable-unsafe-swiftshader"};
+  if (device == "swiftshader" || device == "cpu")
+    return {"--use-angle=swiftshader", "--enable-unsafe-swiftshader"};
+  if (device == "gpu") return {"--use-angle=gl", "--ignore-gpu-blocklist", "--enable-gpu"};
+  throw std::invalid_argument(
+      "the webgl backend's --device is one of gpu, swiftshader (or cpu), or empty for "
+      "Chromium's choice; not " +
+      device);
+}
+
 Chromium::Chromium(const std::string& executable, const std::vector<std::string>& flags,
                    double timeout_s) {
   int to[2], from[2];

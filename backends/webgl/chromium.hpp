@@ -17,6 +17,11 @@ namespace flatmarch::webgl {
 // google-chrome on PATH; none if there is none.
 std::optional<std::string> find_chromium();
 
+// Chromium's flags for the webgl backend's --device: "" lets Chromium choose (a GPU where it can
+// use one, else SwiftShader), "swiftshader" or "cpu" asks for SwiftShader, "gpu" for the GPU
+// (ANGLE on OpenGL). Throws std::invalid_argument on another.
+std::vector<std::string> device_flags(const std::string& device);
+
 class Chromium {
  public:
   // Starts `executable` headless with `flags` added (--disable-gpu: WebGL on SwiftShader), opens

@@ -40,18 +40,6 @@ const char* const kProbe = R"js((() => {
   };
 })())js";
 
-// Chromium's flags for a device choice (WebGlBackend's constructor says which).
-std::vector<std::string> device_flags(const std::string& device) {
-  if (device.empty()) return {"--enable-unsafe-swiftshader"};
-  if (device == "swiftshader" || device == "cpu")
-    return {"--use-angle=swiftshader", "--enable-unsafe-swiftshader"};
-  if (device == "gpu") return {"--use-angle=gl", "--ignore-gpu-blocklist", "--enable-gpu"};
-  throw std::invalid_argument(
-      "the webgl backend's --device is one of gpu, swiftshader (or cpu), "
-      "or empty for Chromium's choice; not " +
-      device);
-}
-
 // Standard base64 (RFC 4648), as the page's btoa() writes it, into bytes.
 std::vector<unsigned char> from_base64(const std::string& text) {
   std::array<int, 256> value;
@@ -155,7 +143,7 @@ WebGlBackend::~WebGlBackend() = default;
 WebGlBackend::Session* WebGlBackend::session() const {
   std::call_once(started_, [this] {
     try {
-      const std::vector<std::string> flags = device_flags(options_.device);
+      const std::vector<std::string> flags = webgl::device_flags(options_.device);
       const std::optional<std::string> chromium = webgl::find_chromium();
       if (!chromium) {
         unavailable_ =
