@@ -18,17 +18,11 @@ int main(int argc, char** argv) {
   using namespace flatmarch;
   // Our own flag first: Google Benchmark reports flags it does not know.
   int width = 640, height = 360;
-  for (int k = 1; k < argc; ++k)
-    if (std::string(argv[k]).rfind("--size=", 0) == 0) {
-      if (std::sscanf(argv[k] + 7, "%dx%d", &width, &height) != 2 || width < 1 || height < 1 ||
-          width > 8192 || height > 8192) {
-        std::cerr << "backend_bench: --size=WxH, each 1 to 8192\n";
-        return 2;
-      }
-      std::copy(argv + k + 1, argv + argc + 1, argv + k);
-      --argc;
-      break;
-    }
+  const auto flags = bench::take_flags(argc, argv, {"size"});
+  if (flags.count("size") && !bench::parse_size(flags.at("size"), width, height)) {
+    std::cerr << "backend_bench: --size=WxH, each 1 to 8192\n";
+    return 2;
+  }
   if (!bench::begin(argc, argv)) return 2;
   reports::add_to_benchmark_context(reports::hardware_fingerprint());
   const std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();

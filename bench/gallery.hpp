@@ -5,8 +5,11 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "backends/backend.hpp"
@@ -24,6 +27,33 @@ using reports::frame_counters;  // the counters every benchmark program reports
 inline void keep_freed_frames() {
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
+
+// Takes a program's own flags, --NAME=VALUE with NAME one of `names`, out of argv before Google
+// Benchmark reads it (it reports flags it does not know); returns their values by name.
+inline std::map<std::string, std::string> take_flags(int& argc, char** argv,
+                                                     const std::vector<std::string>& names) {
+  std::map<std::string, std::string> values;
+  for (int k = 1; k < argc;) {
+    const std::string arg = argv[k];
+    const auto name = std::find_if(names.begin(), names.end(), [&](const std::string& n) {
+      return arg.rfind("--" + n + "=", 0) == 0;
+    });
+    if (name == names.end()) {
+      ++k;
+      continue;
+    }
+    values[*name] = arg.substr(name->size() + 3);
+    std::copy(argv + k + 1, argv + argc + 1, argv + k);
+    --argc;
+  }
+  return values;
+}
+
+// A --size value, WxH with each 1 to 8192, into width and height; false if it is not one.
+inline bool parse_size(const std::string& text, int& width, int& height) {
+  return std::sscanf(text.c_str(), "%dx%d", &width, &height) == 2 && width >= 1 && height >= 1 &&
+         width <= 8192 && height <= 8192;
 }
 
 // What a benchmark program does first: keep freed frames and take Google Benchmark's flags.

@@ -83,19 +83,9 @@ int main(int argc, char** argv) {
   BackendOptions options;
   std::string peer_shaders =
       std::getenv("FLATMARCH_PEER_SHADERS") ? std::getenv("FLATMARCH_PEER_SHADERS") : "";
-  for (int k = 1; k < argc;) {
-    const std::string arg = argv[k];
-    if (arg.rfind("--device=", 0) == 0) {
-      options.device = arg.substr(9);
-    } else if (arg.rfind("--peer-shaders=", 0) == 0) {
-      peer_shaders = arg.substr(15);
-    } else {
-      ++k;
-      continue;
-    }
-    std::copy(argv + k + 1, argv + argc + 1, argv + k);
-    --argc;
-  }
+  const auto flags = bench::take_flags(argc, argv, {"device", "peer-shaders"});
+  if (flags.count("device")) options.device = flags.at("device");
+  if (flags.count("peer-shaders")) peer_shaders = flags.at("peer-shaders");
   if (!bench::begin(argc, argv)) return 2;
   const OpenGlBackend opengl(options);
   const VulkanBackend vulkan(options);

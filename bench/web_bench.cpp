@@ -131,24 +131,12 @@ int main(int argc, char** argv) {
   std::string peer_shaders =
       std::getenv("FLATMARCH_PEER_SHADERS") ? std::getenv("FLATMARCH_PEER_SHADERS") : "";
   bench::Size size;
-  for (int k = 1; k < argc;) {
-    const std::string arg = argv[k];
-    if (arg.rfind("--device=", 0) == 0) {
-      device = arg.substr(9);
-    } else if (arg.rfind("--peer-shaders=", 0) == 0) {
-      peer_shaders = arg.substr(15);
-    } else if (arg.rfind("--size=", 0) == 0) {
-      if (std::sscanf(arg.c_str() + 7, "%dx%d", &size.width, &size.height) != 2 || size.width < 1 ||
-          size.height < 1 || size.width > 8192 || size.height > 8192) {
-        std::cerr << "web_bench: --size wants WxH, each 1 to 8192, not " << arg.substr(7) << "\n";
-        return 2;
-      }
-    } else {
-      ++k;
-      continue;
-    }
-    std::copy(argv + k + 1, argv + argc + 1, argv + k);
-    --argc;
+  const auto flags = bench::take_flags(argc, argv, {"device", "peer-shaders", "size"});
+  if (flags.count("device")) device = flags.at("device");
+  if (flags.count("peer-shaders")) peer_shaders = flags.at("peer-shaders");
+  if (flags.count("size") && !bench::parse_size(flags.at("size"), size.width, size.height)) {
+    std::cerr << "web_bench: --size wants WxH, each 1 to 8192, not " << flags.at("size") << "\n";
+    return 2;
   }
   if (!bench::begin(argc, argv)) return 2;
   const std::optional<std::string> chromium = webgl::find_chromium();

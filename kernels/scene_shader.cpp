@@ -158,7 +158,8 @@ int row_stride(int rows) {
 }
 
 std::string baked_params(const Tables<float>::KernelParams& p) {
-  // In the order of KernelParams' fields (kernels/tables.glsl).
+  // In the order of KernelParams' fields (kernels/tables.glsl). The web page's eps and offset keys
+  // rewrite the fourth and fifth (web/page.js, withParams).
   return "const KernelParams params = KernelParams(\n    " + std::to_string(p.method) + ", " +
          std::to_string(p.max_steps) + ", " + std::to_string(p.polygon_count) + ",\n    " +
          number(p.eps) + ", " + number(p.offset) + ", " + number(p.max_distance) + ", " +

@@ -388,7 +388,7 @@ def ranking_section(results):
                  "Per method: Mrays/s (cases passed; for the "
                  "SIMD backend, the geometric mean of how much of this CPU's peak its frames reach, see Steps). "
                  "A GPU backend names the device it ran on; <i>software</i> marks a rasteriser running on the "
-                 "CPU (Mesa's llvmpipe and lavapipe), whose speed says nothing of a GPU's.</p>")
+                 "CPU (Mesa's llvmpipe and lavapipe, Chromium's SwiftShader), whose speed says nothing of a GPU's.</p>")
     parts.append(table(["rank", "backend", "device", "Mrays/s", "verdicts"] + [f"{m} Mrays/s" for m in methods] +
                        ["fastest conforming method"], rows))
     skipped = results.get("matrix", {}).get("skipped", [])
