@@ -16,6 +16,7 @@ void add_shader(CLI::App& app);
 void add_export_web(CLI::App& app);
 void add_view(CLI::App& app);
 void add_conform(CLI::App& app);
+void add_merge(CLI::App& app);
 void add_report(CLI::App& app);
 void add_select(CLI::App& app);
 void add_sweep(CLI::App& app);

@@ -3,11 +3,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <optional>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "conformance/suite.hpp"
 #include "output/image_io.hpp"
+#include "reports/fingerprint.hpp"
+#include "reports/shard.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::cli {
@@ -61,6 +65,7 @@ void add_conform(CLI::App& app) {
     std::string precision = "f32";
     MarchParams params;
     BackendOptions backend_options;
+    std::string shard;
     bool quiet = false;
     bool strict = false;
   };
@@ -87,6 +92,10 @@ void add_conform(CLI::App& app) {
   cmd->add_option("--precision", o->precision, "f32 or f64 (backends without f64 are skipped)")
       ->capture_default_str();
   add_backend_options(*cmd, o->backend_options);
+  cmd->add_option("--shard", o->shard,
+                  "I/N: run only shard I of N of the cases (split by their expected cost, the same "
+                  "in every shard), for a scheduler to run the shards apart; `flatmarch merge` "
+                  "puts their JSON back together");
   cmd->add_flag("-q,--quiet", o->quiet, "Only the summary line");
   cmd->add_flag("--strict", o->strict,
                 "Exit 1 when a case is at its method's limit too, not only when one fails");
@@ -123,14 +132,27 @@ void add_conform(CLI::App& app) {
                          error.message());
       suite.keep_pixel_classes(true);
     }
-    nlohmann::json out = {{"cases", nlohmann::json::array()}, {"skipped", nlohmann::json::array()}};
+    std::optional<reports::Shard> shard;
+    if (!o->shard.empty() && !(shard = reports::parse_shard(o->shard)))
+      throw UsageError("--shard: I/N with 1 <= I <= N <= 1000, not " + o->shard);
+    nlohmann::json out = {{"format", "flatmarch-conform/1"},
+                          {"fingerprint", reports::hardware_fingerprint()},
+                          {"options",
+                           {{"size", o->size},
+                            {"eps", o->params.eps},
+                            {"offset", o->params.offset},
+                            {"max_steps", o->params.max_steps},
+                            {"max_distance", o->params.max_distance},
+                            {"omega", o->params.omega},
+                            {"precision", o->precision},
+                            {"thresholds", thresholds}}},
+                          {"cases", nlohmann::json::array()},
+                          {"skipped", nlohmann::json::array()}};
     int cases = 0, failed = 0, limits = 0;
-    if (!o->quiet)
-      std::printf("%-8s %-30s %-9s %7s %8s %8s %7s %7s %6s  %-24s %s\n", "backend", "scene",
-                  "method", "ambig%", "hit%", "cross%", "img%", "stepKS", "traces", "failures",
-                  "verdict");
+    // The run's cases, over the backends available here, and the shard of each.
+    std::vector<std::unique_ptr<Backend>> backends;
     for (const std::string& name : o->backends) {
-      const std::unique_ptr<Backend> backend = make_kernel_backend(name, o->backend_options);
+      std::unique_ptr<Backend> backend = make_kernel_backend(name, o->backend_options);
       const Availability a = backend->availability();
       const std::vector<Precision> precisions = backend->precisions();
       std::string skip = a.available ? "" : "unavailable here: " + a.reason;
@@ -142,11 +164,45 @@ void add_conform(CLI::App& app) {
         out["skipped"].push_back({{"backend", name}, {"reason", skip}});
         continue;
       }
+      backends.push_back(std::move(backend));
+    }
+    std::vector<std::string> names;
+    std::vector<double> costs;
+    for (const auto& backend : backends)
       for (const Scene& scene : scenes)
         for (const Method m : methods) {
+          names.push_back(backend->name() + "/" + to_string(m) + "/" + scene.name);
+          int edges = 0;
+          for (const Polygon& polygon : scene.polygons) edges += polygon.size();
+          costs.push_back(
+              reports::conformance_case_cost(backend->name(), to_string(m), edges, w, h));
+        }
+    const std::vector<int> assignment = reports::assign_shards(costs, shard ? shard->count : 1);
+    if (shard) {
+      out["shard"] = reports::shard_record(*shard, names, assignment, costs);
+      const auto& held = out["shard"]["holds"];
+      const double cost = out["shard"]["costs"][static_cast<size_t>(shard->index - 1)];
+      std::fprintf(stderr,
+                   "conform: shard %s holds %zu of the run's %zu cases, about %.0f s here by "
+                   "their expected cost\n",
+                   shard->text().c_str(), held.size(), names.size(), cost);
+    }
+    if (!o->quiet)
+      std::printf("%-8s %-30s %-9s %7s %8s %8s %7s %7s %6s  %-24s %s\n", "backend", "scene",
+                  "method", "ambig%", "hit%", "cross%", "img%", "stepKS", "traces", "failures",
+                  "verdict");
+    size_t next = 0;
+    for (const auto& backend : backends) {
+      const std::string name = backend->name();
+      for (const Scene& scene : scenes)
+        for (const Method m : methods) {
+          if (assignment[next++] != (shard ? shard->index : 1)) continue;
           MarchParams params = o->params;
           params.method = m;
           const conformance::CaseResult r = suite.run(*backend, scene, params, w, h);
+          if (shard && !o->quiet)
+            std::fprintf(stderr, "conform: shard %s: case %d of %zu\n", shard->text().c_str(),
+                         cases + 1, out["shard"]["holds"].size());
           ++cases;
           failed += r.verdict == conformance::Verdict::fail;
           limits += r.verdict == conformance::Verdict::limit;

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   cli::add_export_web(app);
   cli::add_view(app);
   cli::add_conform(app);
+  cli::add_merge(app);
   cli::add_report(app);
   cli::add_select(app);
   cli::add_sweep(app);

@@ -1,0 +1,133 @@
+#include "reports/shard.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+
+namespace flatmarch::reports {
+
+using nlohmann::json;
+
+std::optional<Shard> parse_shard(const std::string& text) {
+  Shard s;
+  char rest = 0;
+  if (std::sscanf(text.c_str(), "%d/%d%c", &s.index, &s.count, &rest) != 2) return std::nullopt;
+  if (s.count < 1 || s.count > 1000 || s.index < 1 || s.index > s.count) return std::nullopt;
+  return s;
+}
+
+std::vector<int> assign_shards(const std::vector<double>& costs, int count) {
+  if (count < 1) throw std::invalid_argument("assign_shards: no shards");
+  std::vector<size_t> order(costs.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return costs[a] > costs[b]; });
+  std::vector<double> load(static_cast<size_t>(count), 0.0);
+  std::vector<int> shard(costs.size(), 1);
+  for (const size_t k : order) {
+    if (!std::isfinite(costs[k]) || costs[k] < 0.0)
+      throw std::invalid_argument("assign_shards: a cost that is not finite and >= 0");
+    const size_t least =
+        static_cast<size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[least] += costs[k];
+    shard[k] = static_cast<int>(least) + 1;
+  }
+  return shard;
+}
+
+double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
+                             int width, int height) {
+  // Relative costs measured on the gallery at 160x90 (conform's per-case seconds): the methods'
+  // steps, the oracle's truth shared by every backend, a browser page's compile.
+  const double pixels = static_cast<double>(width) * static_cast<double>(height);
+  const double steps = method == "analytic" ? 1.0 : method == "relaxed" ? 3.0 : 4.0;
+  const double start = backend == "webgl" ? 3.0 : backend == "scalar" ? 0.5 : 0.3;
+  return start + pixels / 14400.0 * (0.4 + 0.1 * steps) * (1.0 + 0.02 * edges);
+}
+
+json shard_record(const Shard& shard, const std::vector<std::string>& cases,
+                  const std::vector<int>& assignment, const std::vector<double>& costs) {
+  std::vector<double> load(static_cast<size_t>(shard.count), 0.0);
+  json holds = json::array();
+  for (size_t k = 0; k < cases.size(); ++k) {
+    load[static_cast<size_t>(assignment[k] - 1)] += costs[k];
+    if (assignment[k] == shard.index) holds.push_back(cases[k]);
+  }
+  return {{"index", shard.index},
+          {"count", shard.count},
+          {"cases", cases},
+          {"holds", holds},
+          {"costs", load}};
+}
+
+namespace {
+
+[[noreturn]] void bad(const std::string& file, const std::string& why) {
+  throw std::invalid_argument(file + ": " + why);
+}
+
+// What must be the same in every shard of one run, and how to say it differs.
+void same(const std::string& file, const json& doc, const json& first,
+          const std::string& first_file, const char* key, const std::string& what) {
+  if (doc.value(key, json()) != first.value(key, json()))
+    bad(file, what + " " + first_file + "'s: not a shard of the same run");
+}
+
+}  // namespace
+
+json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
+  if (files.empty()) throw std::invalid_argument("nothing to merge");
+  const auto& [first_file, first] = files.front();
+  std::map<int, std::string> seen;  // shard index -> file
+  std::map<std::string, json> cases;
+  for (const auto& [file, doc] : files) {
+    if (!doc.is_object() || doc.value("format", "") != "flatmarch-conform/1")
+      bad(file, "not the results of `flatmarch conform` (no \"format\": \"flatmarch-conform/1\")");
+    if (!doc.contains("shard")) bad(file, "holds no shard (run with --shard I/N)");
+    if (doc["fingerprint"].value("build", json()) != first["fingerprint"].value("build", json()))
+      bad(file, "made by another flatmarch build (" + doc["fingerprint"]["build"].dump() +
+                    ") than " + first_file + " (" + first["fingerprint"]["build"].dump() + ")");
+    same(file, doc, first, first_file, "fingerprint", "measured on another machine than");
+    same(file, doc, first, first_file, "options", "its parameters differ from");
+    const json& s = doc["shard"];
+    if (s["count"] != first["shard"]["count"])
+      bad(file, "is a shard of " + s["count"].dump() + ", " + first_file + " of " +
+                    first["shard"]["count"].dump());
+    if (s["cases"] != first["shard"]["cases"])
+      bad(file, "its run's case list differs from " + first_file + "'s");
+    const int index = s["index"].get<int>();
+    if (seen.count(index))
+      bad(file, "shard " + std::to_string(index) + "/" + s["count"].dump() + " again (also " +
+                    seen[index] + ")");
+    seen[index] = file;
+    const json& holds = s["holds"];
+    for (const json& c : doc["cases"]) {
+      const std::string name = c["backend"].get<std::string>() + "/" +
+                               c["method"].get<std::string>() + "/" + c["scene"].get<std::string>();
+      if (std::find(holds.begin(), holds.end(), name) == holds.end())
+        bad(file, "holds case " + name + ", which is not its shard's");
+      cases[name] = c;
+    }
+    if (doc["cases"].size() != holds.size())
+      bad(file, "holds " + std::to_string(doc["cases"].size()) + " cases where its shard has " +
+                    std::to_string(holds.size()) + " (an interrupted run?)");
+  }
+  const int count = first["shard"]["count"].get<int>();
+  for (int k = 1; k <= count; ++k)
+    if (!seen.count(k))
+      throw std::invalid_argument("shard " + std::to_string(k) + "/" + std::to_string(count) +
+                                  " is missing (given " + std::to_string(files.size()) + " of " +
+                                  std::to_string(count) + ")");
+  json out = {
+      {"format", "flatmarch-conform/1"}, {"fingerprint", first["fingerprint"]},
+      {"options", first["options"]},     {"merged_from", json::array()},
+      {"cases", json::array()},          {"skipped", first.value("skipped", json::array())}};
+  for (const auto& [file, doc] : files) out["merged_from"].push_back(file);
+  for (const json& name : first["shard"]["cases"]) out["cases"].push_back(cases.at(name));
+  return out;
+}
+
+}  // namespace flatmarch::reports
