@@ -1,0 +1,173 @@
+#!/usr/bin/env python3
+"""A sharded conformance run on a real Slurm (issue 24): a single-node cluster on localhost,
+configured in a temporary folder (munged with its own key and socket, slurmctld and slurmd on
+free ports), takes ci/slurm/submit.sh's job array of three `conform --shard I/3` tasks and the
+merge job that depends on it; the merged results must equal an unsharded run's, case by case
+(all but the seconds each took).
+
+    slurm_test.py FLATMARCH SOURCE OUT   exit 0: passed, 1: failed, 77: skipped (no Slurm or
+                                         munge here, not root, or the cluster would not start)
+"""
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+SKIP = 77
+PROGRAMS = ["munged", "munge", "slurmctld", "slurmd", "sbatch", "squeue", "sinfo", "scontrol"]
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(what, test, seconds):
+    """Polls test() every half second for at most `seconds`; returns its last value."""
+    end = time.monotonic() + seconds
+    while True:
+        value = test()
+        if value or time.monotonic() > end:
+            return value
+        time.sleep(0.5)
+
+
+def start_cluster(t):
+    munge = os.path.join(t, "munge")
+    os.makedirs(munge, mode=0o700)
+    key = os.path.join(munge, "munge.key")
+    with open(key, "wb") as f:
+        f.write(os.urandom(1024))
+    os.chmod(key, 0o400)
+    sock = os.path.join(munge, "munge.socket")
+    r = subprocess.run(["munged", "--key-file", key, "--socket", sock, "--force",
+                        "--pid-file", os.path.join(munge, "munged.pid"),
+                        "--log-file", os.path.join(munge, "munged.log"),
+                        "--seed-file", os.path.join(munge, "seed")], capture_output=True, text=True)
+    if r.returncode != 0:
+        return None, f"munged would not start: {r.stderr.strip()}"
+    host = socket.gethostname().split(".")[0]
+    for d in ("state", "spool", "log"):
+        os.makedirs(os.path.join(t, d))
+    conf = os.path.join(t, "slurm.conf")
+    with open(conf, "w") as f:
+        f.write(f"""ClusterName=flatmarch-test
+SlurmctldHost={host}(127.0.0.1)
+SlurmctldPort={free_port()}
+SlurmdPort={free_port()}
+AuthType=auth/munge
+AuthInfo=socket={sock}
+CredType=cred/munge
+SlurmUser=root
+SlurmdUser=root
+StateSaveLocation={t}/state
+SlurmdSpoolDir={t}/spool
+SlurmctldPidFile={t}/slurmctld.pid
+SlurmdPidFile={t}/slurmd.pid
+SlurmctldLogFile={t}/log/slurmctld.log
+SlurmdLogFile={t}/log/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+SchedulerType=sched/builtin
+SchedulerParameters=defer_batch=0
+ReturnToService=2
+MpiDefault=none
+JobCompType=jobcomp/none
+AccountingStorageType=accounting_storage/none
+JobAcctGatherType=jobacct_gather/none
+MinJobAge=600
+NodeName={host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} State=UNKNOWN
+PartitionName=test Nodes={host} Default=YES MaxTime=INFINITE State=UP
+""")
+    env = dict(os.environ, SLURM_CONF=conf)
+    for daemon in ("slurmctld", "slurmd"):
+        r = subprocess.run([daemon, "-f", conf], env=env, capture_output=True, text=True)
+        if r.returncode != 0:
+            return env, f"{daemon} would not start: {r.stderr.strip()}"
+    idle = wait_for("the node", lambda: "idle" in subprocess.run(
+        ["sinfo", "-h", "-o", "%T"], env=env, capture_output=True, text=True).stdout, 60)
+    if not idle:
+        return env, "the node did not come up idle within 60 s"
+    return env, None
+
+
+def stop_cluster(t):
+    for pid_file in ("slurmd.pid", "slurmctld.pid", "munge/munged.pid"):
+        try:
+            with open(os.path.join(t, pid_file)) as f:
+                os.kill(int(f.read().strip()), signal.SIGTERM)
+        except (OSError, ValueError):
+            pass
+
+
+def deterministic(cases):
+    return [{k: v for k, v in c.items() if k != "seconds"} for c in cases]
+
+
+def main():
+    flatmarch, source, out = os.path.abspath(sys.argv[1]), sys.argv[2], os.path.abspath(sys.argv[3])
+    missing = [p for p in PROGRAMS if not shutil.which(p)]
+    if missing:
+        print("skipped: no " + ", ".join(missing) + " here (Debian's slurm-wlm and munge)")
+        return SKIP
+    if os.geteuid() != 0:
+        print("skipped: the single-node cluster runs its daemons as root, and this is not root")
+        return SKIP
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(out)
+    t = tempfile.mkdtemp(prefix="flatmarch-slurm-")
+    try:
+        env, why = start_cluster(t)
+        if why:
+            print("skipped:", why)
+            return SKIP
+        options = ["--backend", "scalar", "--method", "sphere", "--method", "analytic",
+                   "--size", "48x27", "--gallery", os.path.join(source, "scenes")]
+        for s in ("torus", "l_shape", "mirror_pentagon", "cone_pi"):
+            options += ["--scene", s]
+        env["FLATMARCH"] = flatmarch
+        r = subprocess.run([os.path.join(source, "ci", "slurm", "submit.sh"), "3",
+                            os.path.join(out, "sharded"), *options],
+                           env=env, capture_output=True, text=True, timeout=120)
+        if r.returncode != 0:
+            print("FAILED: submit.sh:", r.stderr)
+            return 1
+        print(r.stdout.strip())
+        merge = r.stdout.split()[-1]
+        done = wait_for("the merge", lambda: subprocess.run(
+            ["squeue", "-h", "-j", merge], env=env, capture_output=True, text=True).stdout.strip() == "",
+            600)
+        state = subprocess.run(["scontrol", "show", "job", merge], env=env, capture_output=True,
+                               text=True).stdout
+        merged = os.path.join(out, "sharded", "conform.json")
+        if not done or "JobState=COMPLETED" not in state or not os.path.exists(merged):
+            print("FAILED: the merge job did not complete:", state[:400])
+            for log in sorted(os.listdir(os.path.join(out, "sharded"))):
+                if log.endswith(".log"):
+                    print(log, open(os.path.join(out, "sharded", log)).read()[-600:])
+            return 1
+        whole = os.path.join(out, "whole.json")
+        subprocess.run([flatmarch, "conform", *options, "--json", whole, "-q"], check=True,
+                       capture_output=True, timeout=600)
+        a, b = json.load(open(merged)), json.load(open(whole))
+        if deterministic(a["cases"]) != deterministic(b["cases"]) or a["options"] != b["options"]:
+            print("FAILED: the merged results differ from the unsharded run's")
+            return 1
+        print(f"{len(a['cases'])} cases from 3 shards on Slurm equal the unsharded run's")
+        return 0
+    finally:
+        stop_cluster(t)
+        time.sleep(1)
+        shutil.rmtree(t, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
