@@ -90,7 +90,14 @@ json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
     if (doc["fingerprint"].value("build", json()) != first["fingerprint"].value("build", json()))
       bad(file, "made by another flatmarch build (" + doc["fingerprint"]["build"].dump() +
                     ") than " + first_file + " (" + first["fingerprint"]["build"].dump() + ")");
-    same(file, doc, first, first_file, "fingerprint", "measured on another machine than");
+    // The same kind of machine: a job array runs on several nodes of a cluster, whose host names
+    // alone differ.
+    json machine = doc["fingerprint"], first_machine = first["fingerprint"];
+    machine.erase("host");
+    first_machine.erase("host");
+    if (machine != first_machine)
+      bad(file, "measured on another kind of machine than " + first_file +
+                    " (its fingerprint differs beyond the host name)");
     same(file, doc, first, first_file, "options", "its parameters differ from");
     const json& s = doc["shard"];
     if (s["count"] != first["shard"]["count"])
@@ -121,11 +128,19 @@ json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
       throw std::invalid_argument("shard " + std::to_string(k) + "/" + std::to_string(count) +
                                   " is missing (given " + std::to_string(files.size()) + " of " +
                                   std::to_string(count) + ")");
-  json out = {
-      {"format", "flatmarch-conform/1"}, {"fingerprint", first["fingerprint"]},
-      {"options", first["options"]},     {"merged_from", json::array()},
-      {"cases", json::array()},          {"skipped", first.value("skipped", json::array())}};
-  for (const auto& [file, doc] : files) out["merged_from"].push_back(file);
+  json out = {{"format", "flatmarch-conform/1"},
+              {"fingerprint", first["fingerprint"]},
+              {"options", first["options"]},
+              {"merged_from", json::array()},
+              {"hosts", json::array()},
+              {"cases", json::array()},
+              {"skipped", first.value("skipped", json::array())}};
+  for (const auto& [file, doc] : files) {
+    out["merged_from"].push_back(file);
+    const json host = doc["fingerprint"].value("host", json(""));
+    if (std::find(out["hosts"].begin(), out["hosts"].end(), host) == out["hosts"].end())
+      out["hosts"].push_back(host);
+  }
   for (const json& name : first["shard"]["cases"]) out["cases"].push_back(cases.at(name));
   return out;
 }

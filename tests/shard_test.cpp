@@ -126,18 +126,32 @@ TEST_F(ShardedConform, AWrongSetFailsNamingTheFileAndWhy) {
     std::vector<std::string> files;
     std::string says;
   };
-  // Another build: the same file with another version of flatmarch in its fingerprint.
+  // Another build: the same file with another version of flatmarch in its fingerprint; another
+  // kind of machine: another CPU.
   json doc = read_json(b);
   doc["fingerprint"]["build"]["flatmarch"] = "0.0.0-other";
   const std::string old = dir_ + "/old.json";
   std::ofstream(old) << doc.dump();
-  for (const Wrong& w :
-       std::vector<Wrong>{{{a}, "shard 2/2 is missing"},
-                          {{a, b, b}, b + ": shard 2/2 again (also " + b + ")"},
-                          {{a, other}, other + ": its parameters differ from " + a + "'s"},
-                          {{a, third}, third + ": is a shard of 3, " + a + " of 2"},
-                          {{a, old}, old + ": made by another flatmarch build"},
-                          {{dir_ + "/../nothing.json"}, "nothing.json"}}) {
+  doc = read_json(b);
+  doc["fingerprint"]["cpu"]["model"] = "another CPU";
+  const std::string elsewhere = dir_ + "/elsewhere.json";
+  std::ofstream(elsewhere) << doc.dump();
+  // Another node of the same kind, as a job array spreads its tasks: it merges.
+  doc = read_json(b);
+  doc["fingerprint"]["host"] = "node2";
+  const std::string node2 = dir_ + "/node2.json";
+  std::ofstream(node2) << doc.dump();
+  const auto merged = merge({a, node2});
+  EXPECT_EQ(merged.exit_code, 0) << merged.err;
+  EXPECT_EQ(read_json(dir_ + "/out.json")["hosts"].size(), 2u);
+  for (const Wrong& w : std::vector<Wrong>{
+           {{a}, "shard 2/2 is missing"},
+           {{a, b, b}, b + ": shard 2/2 again (also " + b + ")"},
+           {{a, other}, other + ": its parameters differ from " + a + "'s"},
+           {{a, third}, third + ": is a shard of 3, " + a + " of 2"},
+           {{a, old}, old + ": made by another flatmarch build"},
+           {{a, elsewhere}, elsewhere + ": measured on another kind of machine than " + a},
+           {{dir_ + "/../nothing.json"}, "nothing.json"}}) {
     const auto r = merge(w.files);
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find(w.says), std::string::npos) << r.err;
