@@ -40,12 +40,18 @@ std::vector<int> assign_shards(const std::vector<double>& costs, int count) {
 
 double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
                              int width, int height) {
-  // Relative costs measured on the gallery at 160x90 (conform's per-case seconds): the methods'
-  // steps, the oracle's truth shared by every backend, a browser page's compile.
-  const double pixels = static_cast<double>(width) * static_cast<double>(height);
-  const double steps = method == "analytic" ? 1.0 : method == "relaxed" ? 3.0 : 4.0;
-  const double start = backend == "webgl" ? 3.0 : backend == "scalar" ? 0.5 : 0.3;
-  return start + pixels / 14400.0 * (0.4 + 0.1 * steps) * (1.0 + 0.02 * edges);
+  // Seconds a case took on this 2-core machine at 160x90 (conform's per-case seconds over the
+  // gallery, 2026-11-26): the oracle's truth, traces and mask, about 0.1 s, more with more edges;
+  // then the backend's frames, which sphere and relaxed march in about ten times the analytic
+  // method's steps; a browser's page costs half a second more to open and compile.
+  const double frame = static_cast<double>(width) * static_cast<double>(height) / 14400.0;
+  const double marching = method == "analytic" ? 0.1 : 1.0;
+  const double truth = 0.1 * frame * (1.0 + 0.02 * edges);
+  if (backend == "webgl") return truth + 0.5 + 0.2 * marching * frame;
+  if (backend == "vulkan") return truth + 0.08 + 0.02 * marching * frame;
+  if (backend == "scalar") return truth + 0.07 * marching * frame;
+  if (backend == "opengl") return truth + 0.02 * marching * frame;
+  return truth + 0.01 * marching * frame;  // simd, and backends not measured yet
 }
 
 json shard_record(const Shard& shard, const std::vector<std::string>& cases,

@@ -25,9 +25,9 @@ std::optional<Shard> parse_shard(const std::string& text);
 // the shard with the least cost so far (ties to the lowest). Costs must be finite and >= 0.
 std::vector<int> assign_shards(const std::vector<double>& costs, int count);
 
-// The expected cost of a conformance case, in arbitrary units: its pixels, more for the methods
-// that take more steps and for the devices that start slowly (a browser's page), more for scenes
-// with more edges. Only the split's balance depends on it.
+// The expected seconds of a conformance case on a 2-core machine like this one: the oracle's
+// share, the method's steps on the backend, a browser's page. The split's balance depends on it,
+// and the estimate a shard prints before it starts.
 double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
                              int width, int height);
 
