@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/backend.hpp"
+#include "reports/shard.hpp"
 
 namespace flatmarch::cli {
 
@@ -55,6 +56,25 @@ std::vector<Method> parse_methods(const std::vector<std::string>& names);
 // one (its folder made; runtime_error if it cannot be written).
 nlohmann::json read_json(const std::string& option, const std::filesystem::path& file);
 void write_json(const std::filesystem::path& file, const nlohmann::json& doc);
+
+// --- What `flatmarch report` and `flatmarch merge` share (cli/report.cpp).
+
+// The page of results files (reports/make_report.py with matplotlib, by `python`) in `out`:
+// one file's page, or several machines compared; `previous`: an earlier run's results, compared
+// case by case. runtime_error when it cannot be made.
+void make_report_page(const std::string& python, const std::vector<std::string>& results,
+                      const std::filesystem::path& out, const std::string& previous);
+// python3 with matplotlib: $FLATMARCH_PYTHON, else /usr/bin/python3.
+std::string default_python();
+// The results' regression section: checked against `baseline` (a file; "" for the committed
+// reports/baseline.json when it was measured alike), else "checked" false and why not.
+nlohmann::json regression_section(const nlohmann::json& results, const std::string& baseline);
+// The gate (--baseline): writes OUT/gate.json, prints the findings, and throws
+// ConformanceFailure (exit 1) when a figure regressed; UsageError when the baseline cannot judge.
+void gate(const nlohmann::json& results, const std::string& baseline,
+          const std::filesystem::path& out);
+// A --shard value, I/N (UsageError otherwise).
+reports::Shard parse_shard_option(const std::string& text);
 
 // The precision --precision names: f32 or f64 (UsageError for another).
 Precision parse_precision(const std::string& text);

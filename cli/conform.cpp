@@ -172,10 +172,8 @@ void add_conform(CLI::App& app) {
       for (const Scene& scene : scenes)
         for (const Method m : methods) {
           names.push_back(backend->name() + "/" + to_string(m) + "/" + scene.name);
-          int edges = 0;
-          for (const Polygon& polygon : scene.polygons) edges += polygon.size();
-          costs.push_back(
-              reports::conformance_case_cost(backend->name(), to_string(m), edges, w, h));
+          costs.push_back(reports::conformance_case_cost(backend->name(), to_string(m),
+                                                         reports::edge_count(scene), w, h));
         }
     const std::vector<int> assignment = reports::assign_shards(costs, shard ? shard->count : 1);
     if (shard) {

@@ -1,6 +1,9 @@
 // `flatmarch merge`: the shards of a run, each run apart (`--shard I/N`, on a Slurm job array or
 // a CI matrix), put back together (reports/shard.hpp).
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -10,51 +13,188 @@
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
+#include "reports/gallery.hpp"
+#include "reports/report.hpp"
 #include "reports/shard.hpp"
+#include "reports/sweep.hpp"
 
 namespace flatmarch::cli {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Files = std::vector<std::pair<std::string, json>>;
+
+namespace {
+
+// A file name's safe form: letters, digits, '-', '_' and '.', the rest '_'.
+std::string file_word(const std::string& text) {
+  std::string word;
+  for (char c : text)
+    word += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
+  return word.empty() ? "machine" : word;
+}
+
+// The folder of a file named on the command line ("." for a bare name).
+fs::path folder_of(const fs::path& file) {
+  return file.has_parent_path() ? file.parent_path() : fs::path(".");
+}
+
+// Each shard's images (beside its results.json) into `images`.
+void gather_images(const Files& files, const fs::path& images) {
+  for (const auto& [file, doc] : files) {
+    const fs::path from = folder_of(file) / "images";
+    if (!fs::is_directory(from) || (fs::exists(images) && fs::equivalent(from, images))) continue;
+    fs::create_directories(images);
+    fs::copy(from, images, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  }
+}
+
+// The recommended choice's gallery, drawn here (the shards cannot: the choice needs them all);
+// none, with the reason on stderr, where its scenes or backend are not here.
+void draw_gallery(json& results, const std::vector<std::string>& galleries,
+                  const fs::path& images) {
+  try {
+    std::vector<std::string> names;
+    for (const json& s : results["options"]["scenes"]) names.push_back(s);
+    const std::vector<Scene> scenes = load_scenes(names, galleries);
+    reports::GalleryOptions g;
+    std::tie(g.width, g.height) = parse_size("size", results["options"]["size"]);
+    g.params.max_steps = results["options"]["max_steps"];
+    g.params.max_distance = results["options"]["max_distance"];
+    g.images = images;
+    results["gallery"] = reports::recommended_gallery(scenes, results["recommendation"], g);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "merge: the recommended gallery is not drawn: %s\n", e.what());
+  }
+}
+
+// A machine's shards of `flatmarch report`, merged into `out` with the images, the gallery, the
+// regression section (and the gate), and the page.
+void merge_report_shards(const Files& files, const fs::path& out, const std::string& baseline,
+                         const std::vector<std::string>& galleries, bool html,
+                         const std::string& python) {
+  json results = reports::merge_report(files);
+  const fs::path images = folder_of(out) / "images";
+  gather_images(files, images);
+  if (html) draw_gallery(results, galleries, images);
+  results["regression"] = regression_section(results, baseline);
+  write_json(out, results);
+  std::fprintf(stderr, "merge: %zu shards of `flatmarch report`, %zu matrix cases; wrote %s\n",
+               files.size(), results["matrix"]["cases"].size(), out.c_str());
+  std::printf("%s", reports::describe_selection(results, "").c_str());
+  if (html) {
+    make_report_page(python, {out.string()}, folder_of(out), "");
+    std::printf("merge: open %s\n", (folder_of(out) / "index.html").c_str());
+  }
+  if (!baseline.empty()) gate(results, baseline, folder_of(out));
+}
+
+}  // namespace
 
 void add_merge(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "merge",
       "Put the shards of a sharded run back together: the JSON each shard of `flatmarch conform\n"
-      "--shard I/N` wrote, into one results file with the cases in the run's order, as one\n"
-      "unsharded run writes it. Checks that the files are the shards 1..N of one run (the same\n"
-      "flatmarch build, machine, parameters and case list; none missing, none twice) and names\n"
-      "the file and why when they are not (exit 2).");
+      "--shard I/N`, `flatmarch sweep --shard I/N` or `flatmarch report --shard I/N` wrote, into\n"
+      "one results file with the cases in the run's order, as one unsharded run writes it.\n"
+      "Checks that the files are the shards 1..N of one run (the same flatmarch build, machine,\n"
+      "parameters and case list; none missing, none twice) and names the file and why when they\n"
+      "are not (exit 2). Shards of a report also get what needs them all: the ranking, the\n"
+      "recommendation and the sweep's analysis; their images gathered beside -o, the\n"
+      "recommended gallery drawn, the regression gate (--baseline: exit 1 on a regression) and\n"
+      "the page. Report shards from several kinds of machine merge per machine, into\n"
+      "OUTPUT-MACHINE.json each and a page comparing the machines.");
   struct Options {
     std::vector<std::string> files;
-    std::string out;
+    std::vector<std::string> galleries = {"scenes"};
+    std::string out, baseline, python = default_python();
+    bool no_html = false;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("FILE", o->files, "The shards' results (JSON)")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", o->out, "Where to write the merged results")->required();
+  cmd->add_option("--baseline", o->baseline,
+                  "Report shards: check the merged results against this baseline "
+                  "(reports/baseline.json): exit 1 on a regression")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--gallery", o->galleries,
+                  "Report shards: folders of the run's scenes, for the recommended gallery")
+      ->capture_default_str();
+  cmd->add_flag("--no-html", o->no_html, "Report shards: no gallery, no page");
+  cmd->add_option("--python", o->python, "python3 with matplotlib (env FLATMARCH_PYTHON)")
+      ->capture_default_str();
   cmd->callback([o] {
-    std::vector<std::pair<std::string, nlohmann::json>> docs;
+    Files docs;
     for (const std::string& file : o->files) {
       std::ifstream in(file);
       std::stringstream text;
       text << in.rdbuf();
-      nlohmann::json doc = nlohmann::json::parse(text.str(), nullptr, false);
+      json doc = json::parse(text.str(), nullptr, false);
       if (doc.is_discarded()) throw UsageError(file + ": not JSON");
       docs.emplace_back(file, std::move(doc));
     }
-    nlohmann::json merged;
+    const std::string format =
+        docs.front().second.is_object() ? docs.front().second.value("format", "") : "";
+    const fs::path out(o->out);
     try {
-      merged = reports::merge_conformance(docs);
+      if (format == "flatmarch-report/1") {
+        // The shards by machine, in the order first given.
+        std::vector<Files> machines;
+        std::vector<json> kinds;
+        for (auto& doc : docs) {
+          const json kind = reports::machine_of(doc.second);
+          size_t k = 0;
+          while (k < kinds.size() && kinds[k] != kind) ++k;
+          if (k == kinds.size()) {
+            kinds.push_back(kind);
+            machines.emplace_back();
+          }
+          machines[k].push_back(std::move(doc));
+        }
+        if (machines.size() == 1) {
+          merge_report_shards(machines.front(), out, o->baseline, o->galleries, !o->no_html,
+                              o->python);
+          return;
+        }
+        if (!o->baseline.empty())
+          throw UsageError("--baseline gates one machine's results: these shards come from " +
+                           std::to_string(machines.size()) + " kinds of machine");
+        std::vector<std::string> merged;
+        for (const Files& machine : machines) {
+          const std::string host = machine.front().second["fingerprint"].value("host", "");
+          const std::string cpu = machine.front().second["fingerprint"].value("cpu", "");
+          fs::path file = folder_of(out) / (out.stem().string() + "-" +
+                                            file_word(host.empty() ? cpu : host) + ".json");
+          for (int k = 2; std::find(merged.begin(), merged.end(), file.string()) != merged.end();
+               ++k)
+            file = folder_of(out) / (out.stem().string() + "-" + file_word(host) + "-" +
+                                     std::to_string(k) + ".json");
+          merge_report_shards(machine, file, "", o->galleries, false, o->python);
+          merged.push_back(file.string());
+        }
+        if (!o->no_html) {
+          make_report_page(o->python, merged, folder_of(out), "");
+          std::printf("merge: %zu machines compared: open %s\n", merged.size(),
+                      (folder_of(out) / "index.html").c_str());
+        }
+        return;
+      }
+      if (!o->baseline.empty() || o->no_html)
+        throw UsageError("--baseline and --no-html are for the shards of `flatmarch report`");
+      const json merged = format == "flatmarch-sweep/1" ? reports::merge_sweep(docs)
+                                                        : reports::merge_conformance(docs);
+      write_json(out, merged);
+      std::fprintf(stderr, "merge: %zu shards, %zu %s; wrote %s\n", docs.size(),
+                   merged[format == "flatmarch-sweep/1" ? "points" : "cases"].size(),
+                   format == "flatmarch-sweep/1" ? "points" : "cases", o->out.c_str());
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());
-    } catch (const nlohmann::json::exception& e) {
-      throw UsageError(std::string("a shard's results are not as conform writes them: ") +
+    } catch (const json::exception& e) {
+      throw UsageError(std::string("a shard's results are not as flatmarch writes them: ") +
                        e.what());
     }
-    std::ofstream out(o->out);
-    out << merged.dump(1) << "\n";
-    if (!out) throw UsageError("-o: cannot write " + o->out);
-    std::fprintf(stderr, "merge: %zu shards, %zu cases; wrote %s\n", docs.size(),
-                 merged["cases"].size(), o->out.c_str());
   });
 }
 

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
@@ -27,10 +28,10 @@ std::string quoted(const std::string& word) {
   return q + "'";
 }
 
-// Charts and the page, by reports/make_report.py with matplotlib; `previous`: an earlier run's
-// results, compared case by case.
-void make_html(const std::string& python, const std::vector<std::string>& results,
-               const fs::path& out, const std::string& previous) {
+}  // namespace
+
+void make_report_page(const std::string& python, const std::vector<std::string>& results,
+                      const fs::path& out, const std::string& previous) {
   std::string command = quoted(python) + " " +
                         quoted(FLATMARCH_SOURCE_DIR "/reports/make_report.py") + " -o " +
                         quoted(out.string());
@@ -43,6 +44,8 @@ void make_html(const std::string& python, const std::vector<std::string>& result
         "are in " +
         results.front());
 }
+
+namespace {
 
 // Progress of the report's stages on stderr, one reporter per stage.
 struct StageProgress {
@@ -70,10 +73,9 @@ void check_results_file(const std::string& option, const std::string& file) {
                        "\": not a results file of `flatmarch report`");
 }
 
-// The regression section's figures: this run checked against `given` (--baseline), else
-// against the committed reports/baseline.json when it was measured alike; else "checked" false
-// and why not.
-json regression(const json& results, const std::string& given) {
+}  // namespace
+
+json regression_section(const json& results, const std::string& given) {
   const std::string file = given.empty() ? FLATMARCH_SOURCE_DIR "/reports/baseline.json" : given;
   if (given.empty() && !fs::exists(file))
     return {{"checked", false}, {"why", file + " is not there"}};
@@ -98,7 +100,23 @@ std::string default_python() {
   return "/usr/bin/python3";
 }
 
-}  // namespace
+void gate(const json& results, const std::string& baseline, const fs::path& out) {
+  const json& check = results["regression"];
+  if (!check["checked"].get<bool>())
+    throw UsageError("--baseline: " + baseline + ": " + check["why"].get<std::string>());
+  write_json(out / "gate.json", check);
+  std::printf("%s",
+              reports::describe_gate(check, read_json("--baseline", baseline), baseline).c_str());
+  if (!check["regressions"].empty())
+    throw ConformanceFailure(std::to_string(check["regressions"].size()) +
+                             " figures regressed against " + baseline);
+}
+
+reports::Shard parse_shard_option(const std::string& text) {
+  const std::optional<reports::Shard> shard = reports::parse_shard(text);
+  if (!shard) throw UsageError("--shard: I/N with 1 <= I <= N <= 1000, not " + text);
+  return *shard;
+}
 
 void add_report(CLI::App& app) {
   auto* cmd = app.add_subcommand(
@@ -122,7 +140,7 @@ void add_report(CLI::App& app) {
     std::vector<std::string> results, backends, skip_backends, scenes, methods;
     std::vector<std::string> galleries = {"scenes"};
     std::string out = "reports/out", size, conform_size = "160x90", sweep_size, sweep_backend;
-    std::string baseline, write_baseline, previous, python = default_python();
+    std::string baseline, write_baseline, previous, shard, python = default_python();
     int repetitions = 0;
     double min_time = 0.02;
     bool full = false, no_sweep = false, no_scaling = false, no_html = false, quiet = false;
@@ -170,12 +188,25 @@ void add_report(CLI::App& app) {
                   "Write this run's deterministic figures as a baseline file");
   cmd->add_option("--python", o->python, "python3 with matplotlib (env FLATMARCH_PYTHON)")
       ->capture_default_str();
+  cmd->add_option(
+      "--shard", o->shard,
+      "I/N: measure only shard I of N of the report's cases (matrix cases, sweep groups, "
+      "scaling series; split by their expected cost, the same in every shard) and "
+      "write its results.json and images, for a scheduler to run the shards apart "
+      "(ci/slurm/report.sbatch, .github/workflows/bench.yml); `flatmarch merge` puts "
+      "them together and makes the ranking, the recommendation, the gallery, the gate "
+      "and the page. Prints the shard's estimated time first");
   add_march_param_options(
       *cmd, o->params,
       {.eps = true, .offset = true, .max_steps = true, .max_distance = false, .omega = false});
   add_backend_options(*cmd, o->backend_options);
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
+    if (!o->shard.empty() && (!o->results.empty() || !o->baseline.empty() ||
+                              !o->write_baseline.empty() || !o->previous.empty()))
+      throw UsageError(
+          "--shard measures a part: give --baseline, --write-baseline and --previous to `flatmarch "
+          "merge`, which puts the shards together, and no RESULTS");
     if (!o->previous.empty()) {
       check_results_file("--previous", o->previous);
       if (o->results.size() > 1)
@@ -186,7 +217,7 @@ void add_report(CLI::App& app) {
       if (!o->baseline.empty() || !o->write_baseline.empty())
         throw UsageError("--baseline and --write-baseline measure: give no RESULTS with them");
       for (const std::string& file : o->results) check_results_file("RESULTS", file);
-      make_html(o->python, o->results, o->out, o->previous);
+      make_report_page(o->python, o->results, o->out, o->previous);
       std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
       return;
     }
@@ -255,10 +286,21 @@ void add_report(CLI::App& app) {
       r.scaling.backends = {"scalar", "simd"};
     }
 
+    if (!o->shard.empty()) r.shard = parse_shard_option(o->shard);
+
     StageProgress progress{o->quiet, "", nullptr};
     json results = reports::run_report(scenes, r, std::ref(progress));
     if (progress.reporter) progress.reporter->done();
-    results["regression"] = regression(results, o->baseline);
+    if (r.shard) {
+      const fs::path file = fs::path(o->out) / "results.json";
+      write_json(file, results);
+      std::printf(
+          "report: shard %s: wrote %s; put the shards together with `flatmarch merge "
+          "SHARD.../results.json -o OUT/results.json`\n",
+          r.shard->text().c_str(), file.c_str());
+      return;
+    }
+    results["regression"] = regression_section(results, o->baseline);
     const fs::path file = fs::path(o->out) / "results.json";
     write_json(file, results);
     std::printf("%s", reports::describe_selection(results, "").c_str());
@@ -268,21 +310,10 @@ void add_report(CLI::App& app) {
       std::printf("report: wrote the baseline %s\n", o->write_baseline.c_str());
     }
     if (!o->no_html) {
-      make_html(o->python, {file.string()}, o->out, o->previous);
+      make_report_page(o->python, {file.string()}, o->out, o->previous);
       std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
     }
-    if (!o->baseline.empty()) {
-      const json& check = results["regression"];
-      if (!check["checked"].get<bool>())
-        throw UsageError("--baseline: " + o->baseline + ": " + check["why"].get<std::string>());
-      write_json(fs::path(o->out) / "gate.json", check);
-      std::printf(
-          "%s",
-          reports::describe_gate(check, read_json("--baseline", o->baseline), o->baseline).c_str());
-      if (!check["regressions"].empty())
-        throw ConformanceFailure(std::to_string(check["regressions"].size()) +
-                                 " figures regressed against " + o->baseline);
-    }
+    if (!o->baseline.empty()) gate(results, o->baseline, o->out);
   });
 }
 

@@ -2,11 +2,14 @@
 // the stable region, Pareto front and recommendation per surface type.
 #include <algorithm>
 #include <cstdio>
+#include <memory>
+#include <set>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "conformance/suite.hpp"
 #include "reports/fingerprint.hpp"
+#include "reports/shard.hpp"
 #include "reports/sweep.hpp"
 
 namespace flatmarch::cli {
@@ -24,7 +27,7 @@ void add_sweep(CLI::App& app) {
   struct Options {
     std::vector<std::string> scenes, methods, precisions;
     std::vector<std::string> galleries = {"scenes"};
-    std::string size = "64x36", json = "sweep.json";
+    std::string size = "64x36", json = "sweep.json", shard;
     reports::SweepOptions sweep;
     bool quiet = false;
   };
@@ -46,6 +49,10 @@ void add_sweep(CLI::App& app) {
       {.eps = false, .offset = false, .max_steps = true, .max_distance = false, .omega = false});
   add_backend_options(*cmd, o->sweep.backend_options);
   cmd->add_option("--json", o->json, "Where to write the results")->capture_default_str();
+  cmd->add_option("--shard", o->shard,
+                  "I/N: sweep only shard I of N of the groups (surface type x method, each with "
+                  "its precisions, grid and re-checks; split by their expected cost, the same in "
+                  "every shard); `flatmarch merge` puts the shards' JSON together");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
     std::tie(o->sweep.width, o->sweep.height) = parse_size("--size", o->size);
@@ -75,6 +82,26 @@ void add_sweep(CLI::App& app) {
         }))
       throw UsageError("--precision: the " + o->sweep.backend + " backend marches in f32 only");
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
+    json shard;
+    if (!o->shard.empty()) {
+      const reports::Shard s = parse_shard_option(o->shard);
+      std::vector<std::string> names;
+      std::vector<double> costs;
+      for (const auto& [name, cost] : reports::sweep_cases(scenes, o->sweep)) {
+        names.push_back(name);
+        costs.push_back(cost);
+      }
+      shard = reports::shard_record(s, names, reports::assign_shards(costs, s.count), costs);
+      const auto held =
+          std::make_shared<std::set<std::string>>(shard["holds"].begin(), shard["holds"].end());
+      o->sweep.holds = [held](const std::string& key) { return held->count(key) > 0; };
+      if (!o->quiet)
+        std::fprintf(stderr,
+                     "sweep: shard %s holds %zu of the run's %zu groups, about %.0f s here by "
+                     "their expected costs\n",
+                     s.text().c_str(), held->size(), names.size(),
+                     shard["costs"][static_cast<size_t>(s.index - 1)].get<double>());
+    }
     conformance::Suite suite;
     ProgressReporter progress("sweep", o->quiet);
     json result =
@@ -82,7 +109,16 @@ void add_sweep(CLI::App& app) {
           progress(static_cast<double>(done) / total);
         });
     progress.done();
+    result["format"] = "flatmarch-sweep/1";
     result["fingerprint"] = reports::hardware_fingerprint();
+    result["options"]["scenes"] = json::array();
+    for (const Scene& s : scenes) result["options"]["scenes"].push_back(s.name);
+    result["options"]["methods"] = json::array();
+    for (Method m : o->sweep.methods) result["options"]["methods"].push_back(to_string(m));
+    result["options"]["precisions"] = json::array();
+    for (Precision p : o->sweep.precisions)
+      result["options"]["precisions"].push_back(p == Precision::f32 ? "f32" : "f64");
+    if (!shard.is_null()) result["shard"] = shard;
     write_json(o->json, result);
     std::printf("%-12s %-9s %-4s %7s  %-26s %s\n", "surface", "method", "prec", "stable",
                 "recommended eps / offset", "pareto front (eps, offset: ms, hit mismatch %)");

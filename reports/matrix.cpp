@@ -10,6 +10,7 @@
 
 #include "backends/simd/simd.hpp"
 #include "output/image_io.hpp"
+#include "reports/shard.hpp"
 #include "reports/surfaces.hpp"
 
 namespace flatmarch::reports {
@@ -172,6 +173,8 @@ json run_registered_benchmarks(const std::function<void(const std::string&)>& on
   CollectingReporter reporter(out, on_run);
   benchmark::RunSpecifiedBenchmarks(&reporter, ".*");
   benchmark::ClearRegisteredBenchmarks();
+  // Nothing registered (a shard that holds no timed case): Google Benchmark reports nothing.
+  if (out.str().empty()) return {{"context", json::object()}, {"benchmarks", json::array()}};
   // Google Benchmark writes NaN for a coefficient of variation of zeros (a counter that is 0 in
   // every repetition); JSON has no NaN, so it is read as null.
   static const std::regex not_a_number(R"((:\s*)-?(NaN|nan|inf)\b)");
@@ -217,9 +220,14 @@ std::map<std::string, Timing> timings(const json& document) {
   return result;
 }
 
-json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, conformance::Suite& suite,
-                const MatrixProgress& progress) {
-  json out = {{"cases", json::array()}, {"skipped", json::array()}};
+std::string matrix_case_key(const std::string& backend, Method method, const std::string& scene) {
+  return "matrix/" + backend + "/" + to_string(method) + "/" + scene;
+}
+
+namespace {
+
+// The backends of the matrix that can run here, and the reason each other is skipped.
+std::vector<std::unique_ptr<Backend>> matrix_backends(const MatrixOptions& o, json* skipped) {
   std::vector<std::unique_ptr<Backend>> backends;
   for (const std::string& name : o.backends) {
     std::unique_ptr<Backend> b = make_backend(name, o.backend_options);
@@ -230,13 +238,51 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
     if (skip.empty() && std::find(p.begin(), p.end(), o.params.precision) == p.end())
       skip = "does not march in this precision";
     if (!skip.empty()) {
-      out["skipped"].push_back({{"backend", name}, {"reason", skip}});
-      if (progress) progress(name + " skipped: " + skip, 0, 0);
+      if (skipped) skipped->push_back({{"backend", name}, {"reason", skip}});
       continue;
     }
     backends.push_back(std::move(b));
   }
-  const int total = static_cast<int>(backends.size() * scenes.size() * o.methods.size());
+  return backends;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
+                                                         const MatrixOptions& o) {
+  std::vector<std::pair<std::string, double>> cases;
+  for (const auto& backend : matrix_backends(o, nullptr))
+    for (const Scene& scene : scenes)
+      for (const Method m : o.methods) {
+        const std::string method = to_string(m);
+        double cost = 0.0;
+        if (o.conformance)
+          cost += conformance_case_cost(backend->name(), method, edge_count(scene), o.conform_width,
+                                        o.conform_height);
+        if (o.timing)
+          cost += timed_case_cost(frame_cost(backend->name(), method, o.width, o.height),
+                                  o.repetitions, o.min_time);
+        cases.emplace_back(matrix_case_key(backend->name(), m, scene.name), cost);
+      }
+  return cases;
+}
+
+json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, conformance::Suite& suite,
+                const MatrixProgress& progress) {
+  json out = {{"cases", json::array()}, {"skipped", json::array()}};
+  const std::vector<std::unique_ptr<Backend>> backends = matrix_backends(o, &out["skipped"]);
+  for (const json& skip : out["skipped"])
+    if (progress)
+      progress(
+          skip["backend"].get<std::string>() + " skipped: " + skip["reason"].get<std::string>(), 0,
+          0);
+  const auto held = [&](const Backend& backend, Method m, const Scene& scene) {
+    return !o.holds || o.holds(matrix_case_key(backend.name(), m, scene.name));
+  };
+  int total = 0;
+  for (const auto& backend : backends)
+    for (const Scene& scene : scenes)
+      for (const Method m : o.methods) total += held(*backend, m, scene);
   std::map<std::string, json> cases;
   std::vector<std::string> order;
   // Frames kept for the gallery images, by case name (the first method's).
@@ -247,6 +293,7 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
   for (const auto& backend : backends)
     for (const Scene& scene : scenes)
       for (const Method m : o.methods) {
+        if (!held(*backend, m, scene)) continue;
         MarchParams params = o.params;
         params.method = m;
         const std::string name = case_name(backend->name(), m, scene.name, o.width, o.height);
@@ -297,6 +344,11 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
   if (!o.images.empty())
     if (const Backend* oracle = find_backend("oracle"))
       for (const Scene& scene : scenes) {
+        // A shard draws the truth of its own scenes.
+        if (std::none_of(order.begin(), order.end(), [&](const std::string& name) {
+              return cases[name]["scene"] == scene.name;
+            }))
+          continue;
         MarchParams params = o.params;
         params.method = Method::oracle;
         const std::filesystem::path png = o.images / "oracle" / (scene.name + ".png");

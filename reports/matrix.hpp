@@ -32,7 +32,17 @@ struct MatrixOptions {
   // Where to write each backend's frame of each scene (the first method's) as BACKEND/SCENE.png;
   // empty: nowhere.
   std::filesystem::path images;
+  // The cases to run, by matrix_case_key (a shard's, issue 24); empty: every case.
+  std::function<bool(const std::string& key)> holds;
 };
+
+// A matrix case's key in a sharded run's case list: "matrix/BACKEND/METHOD/SCENE".
+std::string matrix_case_key(const std::string& backend, Method method, const std::string& scene);
+
+// The matrix's cases (backends available here x scenes x methods, in run_matrix's order) by key,
+// each with its expected seconds on this machine (conformance and timing).
+std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
+                                                         const MatrixOptions& options);
 
 // Called with a line of progress: what was done, how many of how many.
 using MatrixProgress = std::function<void(const std::string& line, int done, int total)>;

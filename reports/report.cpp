@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "reports/fingerprint.hpp"
@@ -33,8 +34,59 @@ std::string number(double v) {
 
 }  // namespace
 
-json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
+namespace {
+
+// The scenes the sweep runs on: every scene, or the first of each surface type.
+std::vector<Scene> sweep_scenes(const std::vector<Scene>& scenes, const ReportOptions& o) {
+  std::vector<Scene> chosen;
+  std::set<std::string> types;
+  for (const Scene& s : scenes)
+    if (o.sweep_all_scenes || types.insert(surface_type(s)).second) chosen.push_back(s);
+  return chosen;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> report_cases(const std::vector<Scene>& scenes,
+                                                         const ReportOptions& o) {
+  std::vector<std::pair<std::string, double>> cases = matrix_cases(scenes, o.matrix);
+  if (o.sweep_enabled)
+    for (auto& c : sweep_cases(sweep_scenes(scenes, o), o.sweep)) cases.push_back(std::move(c));
+  if (o.scaling_enabled)
+    for (auto& c : scaling_cases(o.scaling)) cases.push_back(std::move(c));
+  return cases;
+}
+
+json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
                 const ReportProgress& progress) {
+  ReportOptions o = options;
+  json shard;
+  if (o.shard) {
+    std::vector<std::string> names;
+    std::vector<double> costs;
+    for (const auto& [name, cost] : report_cases(scenes, o)) {
+      names.push_back(name);
+      costs.push_back(cost);
+    }
+    const std::vector<int> assignment = assign_shards(costs, o.shard->count);
+    shard = shard_record(*o.shard, names, assignment, costs);
+    const auto held =
+        std::make_shared<std::set<std::string>>(shard["holds"].begin(), shard["holds"].end());
+    const auto holds = [held](const std::string& key) { return held->count(key) > 0; };
+    o.matrix.holds = o.sweep.holds = o.scaling.holds = holds;
+    if (progress) {
+      char line[200];
+      std::snprintf(line, sizeof line,
+                    "shard %s holds %zu of the run's %zu cases, about %.0f s here by their "
+                    "expected costs (each shard's:",
+                    o.shard->text().c_str(), held->size(), names.size(),
+                    shard["costs"][static_cast<size_t>(o.shard->index - 1)].get<double>());
+      std::string text = line;
+      for (const json& c : shard["costs"])
+        text += " " + std::to_string(std::lround(c.get<double>()));
+      progress("shard", text + " s)", 0, 0);
+    }
+  }
   json results = {{"format", "flatmarch-report/1"}, {"created", now_utc()}};
   results["fingerprint"] = hardware_fingerprint();
   add_to_benchmark_context(results["fingerprint"]);
@@ -70,22 +122,21 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& o,
         if (progress) progress("matrix", line, done, total);
       });
   results["seconds"]["matrix"] = lap();
-  if (o.sweep_enabled) {
-    std::vector<Scene> chosen;
-    std::set<std::string> types;
-    for (const Scene& s : scenes)
-      if (o.sweep_all_scenes || types.insert(surface_type(s)).second) chosen.push_back(s);
-    results["sweep"] =
-        run_sweep(chosen, o.sweep, suite, [&](const std::string& line, int done, int total) {
-          if (progress) progress("sweep", line, done, total);
-        });
-  }
+  if (o.sweep_enabled)
+    results["sweep"] = run_sweep(sweep_scenes(scenes, o), o.sweep, suite,
+                                 [&](const std::string& line, int done, int total) {
+                                   if (progress) progress("sweep", line, done, total);
+                                 });
   results["seconds"]["sweep"] = lap();
   if (o.scaling_enabled)
     results["scaling"] = run_scaling(o.scaling, [&](const std::string& line, int done, int total) {
       if (progress) progress("scaling", line, done, total);
     });
   results["seconds"]["scaling"] = lap();
+  if (o.shard) {
+    results["shard"] = shard;
+    return results;
+  }
   results["ranking"] = rank_backends(results["matrix"]);
   results["recommendation"] = recommend(results["ranking"], results.value("sweep", json::object()));
   if (!o.matrix.images.empty())
@@ -505,6 +556,107 @@ std::string describe_gate(const json& check, const json& baseline,
       "warnings, %zu missing\n",
       check["compared"].get<int>(), baseline_file.c_str(), check["regressions"].size(),
       check["improvements"].size(), check["timing_warnings"].size(), check["missing"].size());
+  return out;
+}
+
+}  // namespace flatmarch::reports
+
+namespace flatmarch::reports {
+
+json merge_report(const std::vector<std::pair<std::string, json>>& files) {
+  const std::vector<const std::pair<std::string, json>*> shards =
+      check_shards(files, "flatmarch-report/1", "flatmarch report");
+  const json& first = files.front().second;
+  const json& list = first["shard"]["cases"];
+  std::map<std::string, size_t> position;  // of each case in the run's list
+  for (size_t k = 0; k < list.size(); ++k) position[list[k].get<std::string>()] = k;
+
+  std::map<std::string, json> matrix;  // case key -> case
+  std::set<std::string> found;         // keys of the cases the shards hold results of
+  json benchmarks = json::array(), context = json::object(), scaling_benchmarks = json::array();
+  json points = json::array(), confirmations = json::array(), series = json::array();
+  json sweep_options, seconds = json::object(), per_shard = json::array();
+  for (const auto* entry : shards) {
+    const auto& [file, doc] = *entry;
+    const json& holds = doc["shard"]["holds"];
+    const auto check_held = [&](const std::string& key) {
+      if (std::find(holds.begin(), holds.end(), key) == holds.end())
+        throw std::invalid_argument(file + ": holds " + key + ", which is not its shard's");
+      found.insert(key);
+    };
+    for (const json& c : doc.at("matrix").at("cases")) {
+      const std::string key = "matrix/" + c["backend"].get<std::string>() + "/" +
+                              c["method"].get<std::string>() + "/" + c["scene"].get<std::string>();
+      check_held(key);
+      matrix[key] = c;
+    }
+    const json& timed = doc["matrix"].value("benchmarks", json::object());
+    for (const json& run : timed.value("benchmarks", json::array())) benchmarks.push_back(run);
+    if (context.empty()) context = timed.value("context", json::object());
+    if (doc.contains("sweep")) {
+      if (sweep_options.is_null()) sweep_options = doc["sweep"]["options"];
+      if (doc["sweep"]["options"] != sweep_options)
+        throw std::invalid_argument(file + ": its sweep's options differ from " +
+                                    shards.front()->first + "'s: not a shard of the same run");
+      for (const json& p : doc["sweep"]["points"]) {
+        check_held("sweep/" + p["surface_type"].get<std::string>() + "/" +
+                   p["method"].get<std::string>());
+        points.push_back(p);
+      }
+      for (const json& k : doc["sweep"]["confirmations"]) confirmations.push_back(k);
+    }
+    if (doc.contains("scaling")) {
+      for (const json& s : doc["scaling"]["series"]) {
+        check_held("scaling/" + s["family"].get<std::string>() + "/" +
+                   s["backend"].get<std::string>() + "/" + s["method"].get<std::string>());
+        series.push_back(s);
+      }
+      const json& runs = doc["scaling"].value("benchmarks", json::object());
+      for (const json& run : runs.value("benchmarks", json::array()))
+        scaling_benchmarks.push_back(run);
+    }
+    const json& stages = doc.value("seconds", json::object());
+    for (const auto& [stage, s] : stages.items())
+      seconds[stage] = seconds.value(stage, 0.0) + s.get<double>();
+    per_shard.push_back(
+        {{"file", file},
+         {"host", doc["fingerprint"].value("host", json(""))},
+         {"seconds", doc.value("seconds", json::object())},
+         {"expected_seconds", doc["shard"]["costs"][doc["shard"]["index"].get<size_t>() - 1]}});
+  }
+  for (const auto* entry : shards)
+    for (const json& key : entry->second["shard"]["holds"])
+      if (!found.count(key.get<std::string>()))
+        throw std::invalid_argument(entry->first + ": has no results of " + key.get<std::string>() +
+                                    ", which its shard holds (an interrupted run?)");
+
+  json out = merged_header(files);
+  out["created"] = now_utc();
+  out["registry"] = first["registry"];
+  out["seconds"] = seconds;
+  out["shards"] = per_shard;
+  out["matrix"] = {{"cases", json::array()},
+                   {"skipped", first["matrix"]["skipped"]},
+                   {"benchmarks", {{"context", context}, {"benchmarks", benchmarks}}}};
+  for (const json& key : list)
+    if (matrix.count(key.get<std::string>()))
+      out["matrix"]["cases"].push_back(matrix[key.get<std::string>()]);
+  if (!sweep_options.is_null())
+    out["sweep"] = merged_sweep(sweep_options, std::move(points), std::move(confirmations),
+                                first["options"]["scenes"], first["registry"]["methods"]);
+  if (first.contains("scaling")) {
+    const auto key = [&](const json& s) {
+      return position.at("scaling/" + s["family"].get<std::string>() + "/" +
+                         s["backend"].get<std::string>() + "/" + s["method"].get<std::string>());
+    };
+    std::stable_sort(series.begin(), series.end(),
+                     [&](const json& a, const json& b) { return key(a) < key(b); });
+    out["scaling"] = {{"series", series},
+                      {"skipped", first["scaling"]["skipped"]},
+                      {"benchmarks", {{"context", context}, {"benchmarks", scaling_benchmarks}}}};
+  }
+  out["ranking"] = rank_backends(out["matrix"]);
+  out["recommendation"] = recommend(out["ranking"], out.value("sweep", json::object()));
   return out;
 }
 

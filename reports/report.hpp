@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 
 #include "reports/matrix.hpp"
 #include "reports/scaling.hpp"
+#include "reports/shard.hpp"
 #include "reports/sweep.hpp"
 
 namespace flatmarch::reports {
@@ -22,16 +24,35 @@ struct ReportOptions {
   bool sweep_enabled = true, scaling_enabled = true;
   // Scenes of the sweep: every scene when true, else the first scene of each surface type.
   bool sweep_all_scenes = false;
+  // Run only this shard of the report's cases (report_cases, split by assign_shards); the
+  // results then hold the shard's matrix cases, sweep groups and scaling series and its
+  // shard_record, and no ranking, recommendation or gallery: merge_report makes those.
+  std::optional<Shard> shard;
 };
+
+// The report's cases by key (matrix_case_key, sweep_case_key, scaling_case_key), each with its
+// expected seconds on this machine: what a shard holds, and its estimate before it starts.
+std::vector<std::pair<std::string, double>> report_cases(const std::vector<Scene>& scenes,
+                                                         const ReportOptions& options);
 
 using ReportProgress =
     std::function<void(const std::string& stage, const std::string& line, int done, int total)>;
 
 // Runs what the options ask on the scenes and returns the results document: "format",
 // "created", "fingerprint", "options", "matrix", "sweep", "scaling", "ranking", "recommendation",
-// and with matrix images, "gallery" (recommended_gallery()).
+// and with matrix images, "gallery" (recommended_gallery()); a shard's: "shard" (shard_record)
+// and no ranking, recommendation or gallery. Progress "shard" (a line) says what a shard holds
+// and its estimated seconds before it starts.
 nlohmann::json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
                           const ReportProgress& progress);
+
+// Merges the results of a sharded `flatmarch report` (each file's JSON, with its name for
+// errors), all of one machine: checks that they are the shards 1..N of one run (as
+// merge_conformance) and returns the whole run's results as run_report writes them, the
+// matrix's cases, the sweep's points and the scaling series in the run's order, the sweep's
+// analysis, the ranking and the recommendation made from them; "merged_from", "hosts"; no
+// "gallery" (it renders: the caller's). Throws std::invalid_argument naming the file and why.
+nlohmann::json merge_report(const std::vector<std::pair<std::string, nlohmann::json>>& files);
 
 // The backends by the matrix: those whose every case passed the conformance suite first, each
 // group by the geometric mean of rays per second over its cases; per backend its pass rate,

@@ -1,10 +1,12 @@
 #include "reports/scaling.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
 
 #include "reports/matrix.hpp"
+#include "reports/shard.hpp"
 #include "reports/surfaces.hpp"
 
 namespace flatmarch::reports {
@@ -42,10 +44,16 @@ struct Series {
 
 }  // namespace
 
-json run_scaling(const ScalingOptions& o,
-                 const std::function<void(const std::string&, int, int)>& progress) {
-  // Scenes live as long as the benchmarks that point at them.
-  std::vector<std::unique_ptr<Scene>> scenes;
+std::string scaling_case_key(const std::string& family, const std::string& backend, Method method) {
+  return "scaling/" + family + "/" + backend + "/" + to_string(method);
+}
+
+namespace {
+
+// The series of the options, their scenes kept in `scenes` (they live as long as the benchmarks
+// that point at them).
+std::vector<Series> make_series(const ScalingOptions& o,
+                                std::vector<std::unique_ptr<Scene>>& scenes) {
   const auto keep = [&](Scene s) {
     scenes.push_back(std::make_unique<Scene>(std::move(s)));
     return scenes.back().get();
@@ -77,18 +85,56 @@ json run_scaling(const ScalingOptions& o,
     for (double d : o.max_distances) s.points.push_back({prism, o.width, o.height, d, d});
     series.push_back(s);
   }
+  return series;
+}
 
-  json out = {{"series", json::array()}, {"skipped", json::array()}};
+// The backends of the options that can run here; those that cannot, with the reason, into
+// `skipped` when given.
+std::vector<std::unique_ptr<Backend>> scaling_backends(const ScalingOptions& o, json* skipped) {
   std::vector<std::unique_ptr<Backend>> backends;
   for (const std::string& name : o.backends) {
     std::unique_ptr<Backend> b = make_backend(name, o.backend_options);
     if (!b) throw std::invalid_argument("unknown backend \"" + name + "\"");
     if (const Availability a = b->availability(); !a.available) {
-      out["skipped"].push_back({{"backend", name}, {"reason", "unavailable here: " + a.reason}});
+      if (skipped)
+        skipped->push_back({{"backend", name}, {"reason", "unavailable here: " + a.reason}});
       continue;
     }
     backends.push_back(std::move(b));
   }
+  return backends;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> scaling_cases(const ScalingOptions& o) {
+  std::vector<std::unique_ptr<Scene>> scenes;
+  const std::vector<Series> series = make_series(o, scenes);
+  std::vector<std::pair<std::string, double>> cases;
+  for (const Series& s : series)
+    for (const auto& b : scaling_backends(o, nullptr))
+      for (Method m : o.methods) {
+        double cost = 0.0;
+        for (const Point& p : s.points) {
+          // Rays run to their path length: about max_distance / 20 of a gallery frame's cost.
+          const double frame = frame_cost(b->name(), to_string(m), p.width, p.height) *
+                               std::max(1.0, p.max_distance / 20.0);
+          cost += timed_case_cost(frame, o.repetitions, o.min_time);
+        }
+        cases.emplace_back(scaling_case_key(s.family, b->name(), m), cost);
+      }
+  return cases;
+}
+
+json run_scaling(const ScalingOptions& o,
+                 const std::function<void(const std::string&, int, int)>& progress) {
+  std::vector<std::unique_ptr<Scene>> scenes;
+  const std::vector<Series> series = make_series(o, scenes);
+  json out = {{"series", json::array()}, {"skipped", json::array()}};
+  const std::vector<std::unique_ptr<Backend>> backends = scaling_backends(o, &out["skipped"]);
+  const auto held = [&](const Series& s, const Backend& b, Method m) {
+    return !o.holds || o.holds(scaling_case_key(s.family, b.name(), m));
+  };
   const auto name_of = [](const Series& s, const Backend& b, Method m, const Point& p) {
     return "scaling/" + s.axis + "/" + p.scene->name + "/" + b.name() + "/" + to_string(m) + "/" +
            std::to_string(p.width) + "x" + std::to_string(p.height) + "/d" +
@@ -99,6 +145,7 @@ json run_scaling(const ScalingOptions& o,
     for (const auto& b : backends)
       for (Method m : o.methods)
         for (const Point& p : s.points) {
+          if (!held(s, *b, m)) continue;
           MarchParams params;
           params.method = m;
           params.max_distance = p.max_distance;
@@ -116,6 +163,7 @@ json run_scaling(const ScalingOptions& o,
   for (const Series& s : series)
     for (const auto& b : backends)
       for (Method m : o.methods) {
+        if (!held(s, *b, m)) continue;
         json j = {{"axis", s.axis},
                   {"family", s.family},
                   {"backend", b->name()},

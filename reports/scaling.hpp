@@ -30,7 +30,16 @@ struct ScalingOptions {
   int repetitions = 3;
   double min_time = 0.02;
   double max_distance = 40.0;  // of the edge series
+  // The series to run, by scaling_case_key (a shard's, issue 24); empty: every series.
+  std::function<bool(const std::string& key)> holds;
 };
+
+// A series' key in a sharded run's case list: "scaling/FAMILY/BACKEND/METHOD".
+std::string scaling_case_key(const std::string& family, const std::string& backend, Method method);
+
+// The series (families x backends available here x methods, in run_scaling's order) by key, each
+// with its expected seconds on this machine.
+std::vector<std::pair<std::string, double>> scaling_cases(const ScalingOptions& options);
 
 // The least-squares slope of log(y) against log(x): the exponent of a power law y ~ x^slope.
 double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);

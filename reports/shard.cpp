@@ -38,20 +38,36 @@ std::vector<int> assign_shards(const std::vector<double>& costs, int count) {
   return shard;
 }
 
-double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
-                             int width, int height) {
+double frame_cost(const std::string& backend, const std::string& method, int width, int height) {
   // Seconds a case took on this 2-core machine at 160x90 (conform's per-case seconds over the
-  // gallery, 2026-11-26): the oracle's truth, traces and mask, about 0.1 s, more with more edges;
-  // then the backend's frames, which sphere and relaxed march in about ten times the analytic
-  // method's steps; a browser's page costs half a second more to open and compile.
+  // gallery, 2026-11-26); a browser's page costs half a second more to open and compile.
   const double frame = static_cast<double>(width) * static_cast<double>(height) / 14400.0;
   const double marching = method == "analytic" ? 0.1 : 1.0;
+  if (backend == "webgl") return 0.2 * marching * frame;
+  if (backend == "vulkan") return 0.02 * marching * frame;
+  if (backend == "scalar") return 0.07 * marching * frame;
+  if (backend == "opengl") return 0.02 * marching * frame;
+  return 0.01 * marching * frame;  // simd, and backends not measured yet
+}
+
+double timed_case_cost(double frame_seconds, int repetitions, double min_time) {
+  return frame_seconds + repetitions * (std::max(min_time, frame_seconds) + frame_seconds);
+}
+
+int edge_count(const Scene& scene) {
+  int edges = 0;
+  for (const Polygon& polygon : scene.polygons) edges += static_cast<int>(polygon.size());
+  return edges;
+}
+
+double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
+                             int width, int height) {
+  // The oracle's truth, traces and mask, about 0.1 s at 160x90, more with more edges; then the
+  // backend's frames; a browser's page costs half a second more to open and compile.
+  const double frame = static_cast<double>(width) * static_cast<double>(height) / 14400.0;
   const double truth = 0.1 * frame * (1.0 + 0.02 * edges);
-  if (backend == "webgl") return truth + 0.5 + 0.2 * marching * frame;
-  if (backend == "vulkan") return truth + 0.08 + 0.02 * marching * frame;
-  if (backend == "scalar") return truth + 0.07 * marching * frame;
-  if (backend == "opengl") return truth + 0.02 * marching * frame;
-  return truth + 0.01 * marching * frame;  // simd, and backends not measured yet
+  const double startup = backend == "webgl" ? 0.5 : backend == "vulkan" ? 0.08 : 0.0;
+  return truth + startup + frame_cost(backend, method, width, height);
 }
 
 json shard_record(const Shard& shard, const std::vector<std::string>& cases,
@@ -84,24 +100,23 @@ void same(const std::string& file, const json& doc, const json& first,
 
 }  // namespace
 
-json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
+std::vector<const std::pair<std::string, json>*> check_shards(
+    const std::vector<std::pair<std::string, json>>& files, const std::string& format,
+    const std::string& command) {
   if (files.empty()) throw std::invalid_argument("nothing to merge");
   const auto& [first_file, first] = files.front();
-  std::map<int, std::string> seen;  // shard index -> file
-  std::map<std::string, json> cases;
-  for (const auto& [file, doc] : files) {
-    if (!doc.is_object() || doc.value("format", "") != "flatmarch-conform/1")
-      bad(file, "not the results of `flatmarch conform` (no \"format\": \"flatmarch-conform/1\")");
+  std::map<int, const std::pair<std::string, json>*> seen;  // shard index -> file
+  for (const auto& entry : files) {
+    const auto& [file, doc] = entry;
+    if (!doc.is_object() || doc.value("format", "") != format)
+      bad(file, "not the results of `" + command + "` (no \"format\": \"" + format + "\")");
     if (!doc.contains("shard")) bad(file, "holds no shard (run with --shard I/N)");
     if (doc["fingerprint"].value("build", json()) != first["fingerprint"].value("build", json()))
       bad(file, "made by another flatmarch build (" + doc["fingerprint"]["build"].dump() +
                     ") than " + first_file + " (" + first["fingerprint"]["build"].dump() + ")");
     // The same kind of machine: a job array runs on several nodes of a cluster, whose host names
     // alone differ.
-    json machine = doc["fingerprint"], first_machine = first["fingerprint"];
-    machine.erase("host");
-    first_machine.erase("host");
-    if (machine != first_machine)
+    if (machine_of(doc) != machine_of(first))
       bad(file, "measured on another kind of machine than " + first_file +
                     " (its fingerprint differs beyond the host name)");
     same(file, doc, first, first_file, "options", "its parameters differ from");
@@ -114,9 +129,48 @@ json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
     const int index = s["index"].get<int>();
     if (seen.count(index))
       bad(file, "shard " + std::to_string(index) + "/" + s["count"].dump() + " again (also " +
-                    seen[index] + ")");
-    seen[index] = file;
-    const json& holds = s["holds"];
+                    seen[index]->first + ")");
+    seen[index] = &entry;
+  }
+  const int count = first["shard"]["count"].get<int>();
+  std::vector<const std::pair<std::string, json>*> ordered;
+  for (int k = 1; k <= count; ++k) {
+    if (!seen.count(k))
+      throw std::invalid_argument("shard " + std::to_string(k) + "/" + std::to_string(count) +
+                                  " is missing (given " + std::to_string(files.size()) + " of " +
+                                  std::to_string(count) + ")");
+    ordered.push_back(seen[k]);
+  }
+  return ordered;
+}
+
+json machine_of(const json& results) {
+  json machine = results.value("fingerprint", json::object());
+  if (machine.is_object()) machine.erase("host");
+  return machine;
+}
+
+json merged_header(const std::vector<std::pair<std::string, json>>& files) {
+  const json& first = files.front().second;
+  json out = {{"format", first["format"]},
+              {"fingerprint", first["fingerprint"]},
+              {"options", first["options"]},
+              {"merged_from", json::array()},
+              {"hosts", json::array()}};
+  for (const auto& [file, doc] : files) {
+    out["merged_from"].push_back(file);
+    const json host = doc["fingerprint"].value("host", json(""));
+    if (std::find(out["hosts"].begin(), out["hosts"].end(), host) == out["hosts"].end())
+      out["hosts"].push_back(host);
+  }
+  return out;
+}
+
+json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
+  check_shards(files, "flatmarch-conform/1", "flatmarch conform");
+  std::map<std::string, json> cases;
+  for (const auto& [file, doc] : files) {
+    const json& holds = doc["shard"]["holds"];
     for (const json& c : doc["cases"]) {
       const std::string name = c["backend"].get<std::string>() + "/" +
                                c["method"].get<std::string>() + "/" + c["scene"].get<std::string>();
@@ -128,25 +182,10 @@ json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
       bad(file, "holds " + std::to_string(doc["cases"].size()) + " cases where its shard has " +
                     std::to_string(holds.size()) + " (an interrupted run?)");
   }
-  const int count = first["shard"]["count"].get<int>();
-  for (int k = 1; k <= count; ++k)
-    if (!seen.count(k))
-      throw std::invalid_argument("shard " + std::to_string(k) + "/" + std::to_string(count) +
-                                  " is missing (given " + std::to_string(files.size()) + " of " +
-                                  std::to_string(count) + ")");
-  json out = {{"format", "flatmarch-conform/1"},
-              {"fingerprint", first["fingerprint"]},
-              {"options", first["options"]},
-              {"merged_from", json::array()},
-              {"hosts", json::array()},
-              {"cases", json::array()},
-              {"skipped", first.value("skipped", json::array())}};
-  for (const auto& [file, doc] : files) {
-    out["merged_from"].push_back(file);
-    const json host = doc["fingerprint"].value("host", json(""));
-    if (std::find(out["hosts"].begin(), out["hosts"].end(), host) == out["hosts"].end())
-      out["hosts"].push_back(host);
-  }
+  const json& first = files.front().second;
+  json out = merged_header(files);
+  out["cases"] = json::array();
+  out["skipped"] = first.value("skipped", json::array());
   for (const json& name : first["shard"]["cases"]) out["cases"].push_back(cases.at(name));
   return out;
 }

@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/scene.hpp"
+
 namespace flatmarch::reports {
 
 // Shard I of N, I from 1 (as written: "2/7").
@@ -31,10 +33,37 @@ std::vector<int> assign_shards(const std::vector<double>& costs, int count);
 double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
                              int width, int height);
 
+// The expected seconds of one frame of WxH by `backend` and `method` on this machine (sphere and
+// relaxed march about ten times the analytic method's steps).
+double frame_cost(const std::string& backend, const std::string& method, int width, int height);
+
+// The expected seconds of a case timed by Google Benchmark: an untimed frame, then `repetitions`
+// of at least `min_time` seconds and one frame each.
+double timed_case_cost(double frame_seconds, int repetitions, double min_time);
+
+// The number of edges of a scene's polygons: the oracle's cost grows with it.
+int edge_count(const Scene& scene);
+
 // What a shard's results carry so that merge() can check they belong together: the shard, the
 // whole run's case list (names, in order), and the cost of each shard's cases.
 nlohmann::json shard_record(const Shard& shard, const std::vector<std::string>& cases,
                             const std::vector<int>& assignment, const std::vector<double>& costs);
+
+// Checks that `files` (each file's JSON, with its name for errors) are the shards 1..N of one
+// run of `command`, whose results have "format": `format`: the same flatmarch build, machine
+// (machine_of), parameters ("options") and case list; none missing, none twice. Returns them by
+// shard index. Throws std::invalid_argument naming the file and why.
+std::vector<const std::pair<std::string, nlohmann::json>*> check_shards(
+    const std::vector<std::pair<std::string, nlohmann::json>>& files, const std::string& format,
+    const std::string& command);
+
+// A results file's machine: its fingerprint without the host name (the nodes of a cluster's
+// job array differ by that alone).
+nlohmann::json machine_of(const nlohmann::json& results);
+
+// What every merged result begins with: the first shard's format, fingerprint and options, and
+// "merged_from" (the files) and "hosts" (where the shards ran).
+nlohmann::json merged_header(const std::vector<std::pair<std::string, nlohmann::json>>& files);
 
 // Merges the results of a sharded `flatmarch conform` (each file's JSON, with its name for
 // errors): checks that they are the shards 1..N of one run (same format, flatmarch build,

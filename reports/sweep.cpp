@@ -6,10 +6,12 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 
 #include "reports/matrix.hpp"
+#include "reports/shard.hpp"
 #include "reports/surfaces.hpp"
 
 namespace flatmarch::reports {
@@ -41,6 +43,19 @@ bool stable_point(const json& accuracy) {
 
 const std::string kFailurePrefix = "failures.";
 
+// A re-check's group, as the analysis orders them.
+auto confirmation_group(const json& k) {
+  return std::tie(k["surface_type"].get_ref<const std::string&>(),
+                  k["method"].get_ref<const std::string&>(),
+                  k["precision"].get_ref<const std::string&>());
+}
+
+void sort_confirmations(json& confirmations) {
+  std::stable_sort(confirmations.begin(), confirmations.end(), [](const json& a, const json& b) {
+    return confirmation_group(a) < confirmation_group(b);
+  });
+}
+
 }  // namespace
 
 std::vector<std::string> offset_labels(const SweepOptions& o) {
@@ -50,29 +65,78 @@ std::vector<std::string> offset_labels(const SweepOptions& o) {
   return labels;
 }
 
+std::string sweep_case_key(const std::string& surface_type, Method method) {
+  return "sweep/" + surface_type + "/" + to_string(method);
+}
+
+namespace {
+
+// The precisions of `options` that its backend marches in (none for an unknown backend).
+std::vector<Precision> sweep_precisions(const Backend& backend, const SweepOptions& o) {
+  std::vector<Precision> precisions;
+  const std::vector<Precision> has = backend.precisions();
+  for (Precision p : o.precisions)
+    if (std::find(has.begin(), has.end(), p) != has.end()) precisions.push_back(p);
+  return precisions;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> sweep_cases(const std::vector<Scene>& scenes,
+                                                        const SweepOptions& o) {
+  const std::unique_ptr<Backend> backend = make_backend(o.backend, o.backend_options);
+  const size_t precisions = backend ? sweep_precisions(*backend, o).size() : 0;
+  const size_t grid = o.eps.size() * (o.offset_factors.size() + o.offset_fixed.size());
+  std::vector<std::string> types;
+  for (const Scene& s : scenes)
+    if (std::find(types.begin(), types.end(), surface_type(s)) == types.end())
+      types.push_back(surface_type(s));
+  std::vector<std::pair<std::string, double>> cases;
+  for (const std::string& type : types)
+    for (Method m : o.methods) {
+      const std::string method = to_string(m);
+      double cost = 0.0;
+      for (const Scene& s : scenes) {
+        if (surface_type(s) != type) continue;
+        const int edges = edge_count(s);
+        const double point = conformance_case_cost(o.backend, method, edges, o.width, o.height) +
+                             (o.repetitions - 1) * frame_cost(o.backend, method, o.width, o.height);
+        // Two rounds of re-checks at the larger size, as a rule.
+        const double recheck = conformance_case_cost(
+            o.backend, method, edges, o.width * o.confirm_scale, o.height * o.confirm_scale);
+        cost += static_cast<double>(precisions) *
+                (static_cast<double>(grid) * point + (o.confirm_scale > 1 ? 2.0 * recheck : 0.0));
+      }
+      cases.emplace_back(sweep_case_key(type, m), cost);
+    }
+  return cases;
+}
+
 json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conformance::Suite& suite,
                const SweepProgress& progress) {
   const std::unique_ptr<Backend> backend = make_backend(o.backend, o.backend_options);
   if (!backend) throw std::invalid_argument("unknown backend \"" + o.backend + "\"");
   if (const Availability a = backend->availability(); !a.available)
     throw std::invalid_argument("the " + o.backend + " backend is unavailable here: " + a.reason);
-  std::vector<Precision> precisions;
-  for (Precision p : o.precisions) {
-    const std::vector<Precision> has = backend->precisions();
-    if (std::find(has.begin(), has.end(), p) != has.end()) precisions.push_back(p);
-  }
+  const std::vector<Precision> precisions = sweep_precisions(*backend, o);
   if (precisions.empty())
     throw std::invalid_argument("the " + o.backend +
                                 " backend marches in none of the precisions asked for");
   // Every point is judged against one truth, masked as for the default parameters.
   suite.fix_mask(MarchParams{});
   const std::vector<std::string> labels = offset_labels(o);
-  const int total = static_cast<int>(scenes.size() * o.methods.size() * precisions.size() *
-                                     o.eps.size() * labels.size());
+  const auto held = [&](const Scene& scene, Method m) {
+    return !o.holds || o.holds(sweep_case_key(surface_type(scene), m));
+  };
+  int groups = 0;
+  for (const Scene& scene : scenes)
+    for (Method m : o.methods) groups += held(scene, m);
+  const int total = static_cast<int>(groups * precisions.size() * o.eps.size() * labels.size());
   json points = json::array();
   int done = 0;
   for (const Scene& scene : scenes)
-    for (Method m : o.methods)
+    for (Method m : o.methods) {
+      if (!held(scene, m)) continue;
       for (Precision p : precisions)
         for (double eps : o.eps)
           for (size_t k = 0; k < labels.size(); ++k) {
@@ -114,6 +178,7 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
                            " eps=" + number(eps) + " offset=" + labels[k],
                        ++done, total);
           }
+    }
   // Each recommended point again at confirm_scale times the frame size, on every scene of its
   // type: a point that passed only because the small frames missed a few failing rays drops
   // out, and the analysis picks again (a few rounds: each re-check removes one point).
@@ -162,6 +227,8 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
     if (!again) break;
     analysis = analyse_sweep(points, confirmations);
   }
+  // By group, as the analysis: the order a shard's groups merge into (issue 24).
+  sort_confirmations(confirmations);
   json options = {
       {"backend", o.backend},
       {"eps", o.eps},
@@ -176,6 +243,54 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
           {"points", points},
           {"confirmations", confirmations},
           {"analysis", analysis}};
+}
+
+json merged_sweep(const json& options, json points, json confirmations, const json& scenes,
+                  const json& methods) {
+  const auto index_in = [](const json& names, const json& name) {
+    return static_cast<size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  // A scene's points of a method are one group's, so one shard's, in the order made.
+  std::stable_sort(points.begin(), points.end(), [&](const json& a, const json& b) {
+    return std::pair(index_in(scenes, a["scene"]), index_in(methods, a["method"])) <
+           std::pair(index_in(scenes, b["scene"]), index_in(methods, b["method"]));
+  });
+  sort_confirmations(confirmations);
+  json analysis = analyse_sweep(points, confirmations);
+  return {{"options", options},
+          {"points", std::move(points)},
+          {"confirmations", std::move(confirmations)},
+          {"analysis", std::move(analysis)}};
+}
+
+json merge_sweep(const std::vector<std::pair<std::string, json>>& files) {
+  const auto shards = check_shards(files, "flatmarch-sweep/1", "flatmarch sweep");
+  json points = json::array(), confirmations = json::array();
+  std::set<std::string> found;
+  for (const auto* entry : shards) {
+    const auto& [file, doc] = *entry;
+    const json& holds = doc["shard"]["holds"];
+    for (const json& p : doc.at("points")) {
+      const std::string key =
+          "sweep/" + p["surface_type"].get<std::string>() + "/" + p["method"].get<std::string>();
+      if (std::find(holds.begin(), holds.end(), key) == holds.end())
+        throw std::invalid_argument(file + ": holds " + key + ", which is not its shard's");
+      found.insert(key);
+      points.push_back(p);
+    }
+    for (const json& k : doc.at("confirmations")) confirmations.push_back(k);
+    for (const json& key : holds)
+      if (!found.count(key.get<std::string>()))
+        throw std::invalid_argument(file + ": has no results of " + key.get<std::string>() +
+                                    ", which its shard holds (an interrupted run?)");
+  }
+  const json& first = files.front().second;
+  json methods = json::array();
+  for (Method m : kKernelMethods) methods.push_back(to_string(m));
+  json out = merged_header(files);
+  out.update(merged_sweep(first["options"], std::move(points), std::move(confirmations),
+                          first["options"].value("scenes", json::array()), methods));
+  return out;
 }
 
 json analyse_sweep(const json& points, const json& confirmations) {
@@ -322,9 +437,8 @@ json analyse_sweep(const json& points, const json& confirmations) {
       }
     // Recommended: of the stable points whose eps neighbours (a decade either side, same offset
     // rule) are stable too, so that neither rounding nor a neighbouring choice tips them (failing
-    // that, of all stable points), those within 10% of the fastest — closer than this machine's
-    // timing noise — and of these the one with the most stable neighbours on the grid, then the
-    // one nearest the defaults.
+    // that, of all stable points), those within 10% of the fewest mean steps, and of these the
+    // one with the most stable neighbours on the grid, then the one nearest the defaults.
     std::sort(g.eps.begin(), g.eps.end());
     const auto stable_at = [&](long e, long k) {
       if (e < 0 || k < 0 || e >= static_cast<long>(g.eps.size()) ||
@@ -358,9 +472,13 @@ json analyse_sweep(const json& points, const json& confirmations) {
     const bool any_interior = std::any_of(candidates.begin(), candidates.end(),
                                           [](const Candidate& c) { return c.interior; });
     std::erase_if(candidates, [&](const Candidate& c) { return any_interior && !c.interior; });
-    double fastest = std::numeric_limits<double>::infinity();
-    for (const Candidate& c : candidates) fastest = std::min(fastest, c.cell->time_ms);
-    std::erase_if(candidates, [&](const Candidate& c) { return c.cell->time_ms > 1.1 * fastest; });
+    // Speed by the mean steps, which a frame's time follows on one backend and method, and
+    // which, unlike the time, every run measures alike: the pick is the same on every run and
+    // in every shard (issue 24).
+    double fewest = std::numeric_limits<double>::infinity();
+    for (const Candidate& c : candidates) fewest = std::min(fewest, c.cell->steps_mean);
+    std::erase_if(candidates,
+                  [&](const Candidate& c) { return c.cell->steps_mean > 1.1 * fewest; });
     const auto chosen = std::min_element(candidates.begin(), candidates.end(),
                                          [](const Candidate& a, const Candidate& b) {
                                            if (a.margin != b.margin) return a.margin > b.margin;
@@ -386,8 +504,8 @@ json analyse_sweep(const json& points, const json& confirmations) {
                                                    "decade of eps either side are stable too"
                                                  : "of the stable points (none has stable "
                                                    "neighbours a decade of eps either side)") +
-                                ", within 10% of the fastest, the one with the most stable "
-                                "neighbours on the grid"}}
+                                ", within 10% of the fewest mean steps, the one with the "
+                                "most stable neighbours on the grid"}}
              : json(nullptr);
     analysis.push_back(group);
   }

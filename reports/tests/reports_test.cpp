@@ -140,7 +140,7 @@ const json& cell(const json& group, double eps, const std::string& label) {
 
 TEST(SweepAnalysis, RecommendsTheFastestPointWithStableNeighbours) {
   // eps 1e-1 fails everywhere; 1e-2 is stable for one scene only; 1e-3 ... 1e-5 are stable.
-  // Time grows as eps shrinks. The fastest stable point, 1e-3, has an unstable neighbour
+  // Time and steps grow as eps shrinks. The fastest stable point, 1e-3, has an unstable neighbour
   // (1e-2); 1e-4 is the fastest with both neighbours stable.
   json points = json::array();
   const double eps[] = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5};
