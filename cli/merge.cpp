@@ -164,7 +164,8 @@ void add_merge(CLI::App& app) {
         std::vector<std::string> merged;
         for (const Files& machine : machines) {
           const std::string host = machine.front().second["fingerprint"].value("host", "");
-          const std::string cpu = machine.front().second["fingerprint"].value("cpu", "");
+          const std::string cpu = machine.front().second["fingerprint"].value(
+              json::json_pointer("/cpu/model"), std::string());
           fs::path file = folder_of(out) / (out.stem().string() + "-" +
                                             file_word(host.empty() ? cpu : host) + ".json");
           for (int k = 2; std::find(merged.begin(), merged.end(), file.string()) != merged.end();

@@ -108,6 +108,11 @@ std::string describe_machine(const nlohmann::json& fp) {
 }
 
 void add_to_benchmark_context(const nlohmann::json& fingerprint) {
+  // Google Benchmark keeps its context for the life of the process and refuses a key twice; a
+  // process that runs several reports (a test, shards in turn) adds the machine once.
+  static bool added = false;
+  if (added) return;
+  added = true;
   const nlohmann::json flat = fingerprint.flatten();  // items() refers to it, not a copy
   for (const auto& item : flat.items())
     benchmark::AddCustomContext("fingerprint" + item.key(), item.value().is_string()

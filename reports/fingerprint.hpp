@@ -13,7 +13,7 @@ nlohmann::json hardware_fingerprint();
 std::string describe_machine(const nlohmann::json& fingerprint);
 
 // Adds the fingerprint's fields to Google Benchmark's context ("fingerprint.cpu.model", ...), so
-// that the JSON of the benchmark programs carries it too.
+// that the JSON of the benchmark programs carries it too; once a process (later calls do nothing).
 void add_to_benchmark_context(const nlohmann::json& fingerprint);
 
 }  // namespace flatmarch::reports

@@ -1,5 +1,6 @@
 // Sharded runs (issue 24): the split of a run's cases among N shards, and `flatmarch merge`
-// putting `conform --shard I/N` results back together as one unsharded run writes them.
+// putting `conform --shard I/N` and `report --shard I/N` results back together as one unsharded
+// run writes them.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "reports/report.hpp"
 #include "reports/shard.hpp"
+#include "scene/load.hpp"
 #include "tests/process.hpp"
 
 namespace flatmarch {
@@ -156,6 +159,225 @@ TEST_F(ShardedConform, AWrongSetFailsNamingTheFileAndWhy) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find(w.says), std::string::npos) << r.err;
   }
+}
+
+// --- Sharded reports.
+
+// A small report: two backends, two methods, four scenes of three surface types, a coarse sweep
+// with its re-checks, short scaling series.
+reports::ReportOptions small_report() {
+  reports::ReportOptions r;
+  r.matrix.backends = {"scalar", "simd"};
+  r.matrix.methods = {Method::sphere, Method::analytic};
+  r.matrix.width = r.matrix.conform_width = 32;
+  r.matrix.height = r.matrix.conform_height = 18;
+  r.matrix.repetitions = 2;
+  r.matrix.min_time = 0.001;
+  r.sweep.methods = r.matrix.methods;
+  r.sweep.eps = {1e-2, 1e-3, 1e-4, 1e-5};
+  r.sweep.offset_factors = {2.0, 10.0};
+  r.sweep.offset_fixed = {1e-2};
+  r.sweep.width = 16;
+  r.sweep.height = 9;
+  r.sweep.repetitions = 1;
+  r.scaling.backends = {"scalar", "simd"};
+  r.scaling.methods = {Method::analytic};
+  r.scaling.polygon_n = {2, 4};
+  r.scaling.staircase_squares = {2, 4};
+  r.scaling.resolutions = {{16, 9}, {32, 18}};
+  r.scaling.max_distances = {10, 20};
+  r.scaling.width = 32;
+  r.scaling.height = 18;
+  r.scaling.repetitions = 2;
+  r.scaling.min_time = 0.001;
+  return r;
+}
+
+std::vector<Scene> small_gallery() {
+  std::vector<Scene> scenes;
+  for (const char* s : {"torus", "l_shape", "mirror_pentagon", "cone_pi"})
+    scenes.push_back(load_scene(std::string(FLATMARCH_SOURCE_DIR) + "/scenes/" + s + ".json"));
+  return scenes;
+}
+
+// What a rerun measures alike: every field but the timings (and what is ranked by them).
+json deterministic_report(const json& results) {
+  json d;
+  for (json c : results["matrix"]["cases"]) {
+    c.erase("time_ms");
+    c.erase("time_samples_ms");
+    json counters;
+    for (const char* k : {"steps_mean", "steps_p99", "crossings_mean", "out_of_steps"})
+      counters[k] = c["counters"][k];
+    c["counters"] = counters;
+    d["matrix"].push_back(c);
+  }
+  d["skipped"] = results["matrix"]["skipped"];
+  for (json p : results["sweep"]["points"]) {
+    p.erase("time_ms");
+    d["points"].push_back(p);
+  }
+  d["confirmations"] = results["sweep"]["confirmations"];
+  for (json g : results["sweep"]["analysis"]) {
+    g.erase("pareto");
+    for (json& cell : g["grid"]) cell.erase("time_ms");
+    if (!g["recommended"].is_null()) g["recommended"].erase("time_ms");
+    d["analysis"].push_back(g);
+  }
+  for (json s : results["scaling"]["series"]) {
+    for (const char* k : {"time_ms", "slope", "lane_utilisation"}) s.erase(k);
+    d["scaling"].push_back(s);
+  }
+  for (const json& b : results["ranking"])
+    for (const char* k : {"cases", "passed", "limits", "errors"})
+      d["ranking"][b["backend"].get<std::string>()][k] = b[k];
+  d["recommendation"] = results["recommendation"];
+  d["recommendation"].erase("rays_per_s");
+  return d;
+}
+
+TEST(ShardedReport, MergedShardsEqualAnUnshardedRun) {
+  const std::vector<Scene> scenes = small_gallery();
+  const reports::ReportOptions options = small_report();
+  const json whole = reports::run_report(scenes, options, nullptr);
+  const json expected = deterministic_report(whole);
+  ASSERT_EQ(expected["matrix"].size(), 16u);
+  ASSERT_FALSE(expected["points"].empty());
+  ASSERT_FALSE(expected["confirmations"].empty());
+  ASSERT_EQ(expected["scaling"].size(), 8u);  // 4 families x 2 backends
+  const std::vector<std::pair<std::string, double>> cases = reports::report_cases(scenes, options);
+  for (const int n : {1, 2, 3, 7}) {
+    std::vector<std::pair<std::string, json>> shards;
+    std::vector<std::string> progress;
+    for (int i = n; i >= 1; --i) {  // in any order
+      reports::ReportOptions o = options;
+      o.shard = reports::Shard{i, n};
+      json r = reports::run_report(
+          scenes, o, [&](const std::string& stage, const std::string& line, int, int) {
+            if (stage == "shard") progress.push_back(line);
+          });
+      EXPECT_FALSE(r.contains("ranking")) << "a shard ranks nothing";
+      EXPECT_EQ(r["shard"]["cases"].size(), cases.size());
+      shards.emplace_back("shard" + std::to_string(i), std::move(r));
+    }
+    // Each shard says what it holds and its estimated time before it starts.
+    ASSERT_EQ(progress.size(), static_cast<size_t>(n));
+    EXPECT_EQ(progress.back().rfind("shard 1/" + std::to_string(n) + " holds", 0), 0u)
+        << progress.back();
+    const json merged = reports::merge_report(shards);
+    EXPECT_EQ(deterministic_report(merged), expected) << n << " shards";
+    EXPECT_EQ(merged["options"], whole["options"]);
+    // Timings present for every case.
+    for (const json& c : merged["matrix"]["cases"]) {
+      EXPECT_GT(c["time_ms"].get<double>(), 0.0) << c["name"];
+      EXPECT_EQ(c["time_samples_ms"].size(), 2u) << c["name"];
+    }
+    for (const json& p : merged["sweep"]["points"]) EXPECT_GT(p["time_ms"].get<double>(), 0.0);
+    for (const json& s : merged["scaling"]["series"])
+      EXPECT_EQ(s["time_ms"].size(), 2u) << s["family"];
+    EXPECT_EQ(merged["shards"].size(), static_cast<size_t>(n));
+  }
+}
+
+TEST(ShardedReport, AWrongSetFailsNamingTheFileAndWhy) {
+  const std::vector<Scene> scenes = small_gallery();
+  reports::ReportOptions o = small_report();
+  o.sweep_enabled = o.scaling_enabled = false;
+  const auto shard = [&](int i, int n, double eps = 1e-4) {
+    reports::ReportOptions s = o;
+    s.shard = reports::Shard{i, n};
+    s.matrix.params.eps = eps;
+    return reports::run_report(scenes, s, nullptr);
+  };
+  const json a = shard(1, 2), b = shard(2, 2), other = shard(2, 2, 1e-3);
+  json truncated = b;
+  truncated["matrix"]["cases"].erase(truncated["matrix"]["cases"].size() - 1);
+  json conform = b;
+  conform["format"] = "flatmarch-conform/1";
+  const auto says = [](const std::vector<std::pair<std::string, json>>& files) {
+    try {
+      reports::merge_report(files);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("merged");
+  };
+  EXPECT_EQ(says({{"a", a}, {"b", b}}), "merged");
+  EXPECT_EQ(says({{"a", a}}), "shard 2/2 is missing (given 1 of 2)");
+  EXPECT_EQ(says({{"a", a}, {"b", b}, {"b2", b}}).rfind("b2: shard 2/2 again (also b)", 0), 0u);
+  EXPECT_EQ(says({{"a", a}, {"other", other}}).rfind("other: its parameters differ from a's", 0),
+            0u);
+  EXPECT_NE(says({{"a", a}, {"cut", truncated}}).find("cut: has no results of matrix/"),
+            std::string::npos);
+  EXPECT_EQ(says({{"a", a}, {"c", conform}}).rfind("c: not the results of `flatmarch report`", 0),
+            0u);
+}
+
+// The command line: shards written by `report --shard`, merged by `flatmarch merge` with the
+// images gathered; a bad set exits 2 naming the file; several machines merge apart.
+TEST(ShardedReport, ReportShardsMergeOnTheCommandLine) {
+  const std::string dir = test::make_temp_dir();
+  const auto report = [&](const std::string& out, const std::string& i_of_n) {
+    return test::run_flatmarch({"report",
+                                "--backend",
+                                "scalar",
+                                "--method",
+                                "analytic",
+                                "--scene",
+                                "torus",
+                                "--scene",
+                                "cone_pi",
+                                "--gallery",
+                                std::string(FLATMARCH_SOURCE_DIR) + "/scenes",
+                                "--size",
+                                "32x18",
+                                "--conform-size",
+                                "32x18",
+                                "--repetitions",
+                                "2",
+                                "--min-time",
+                                "0.001",
+                                "--no-sweep",
+                                "--no-scaling",
+                                "-q",
+                                "-o",
+                                out,
+                                "--shard",
+                                i_of_n},
+                               300.0);
+  };
+  for (const char* i : {"1", "2"}) {
+    const auto r = report(dir + "/s" + i, std::string(i) + "/2");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("report: shard " + std::string(i) + "/2: wrote"), std::string::npos);
+  }
+  auto r = test::run_flatmarch({"merge", dir + "/s2/results.json", dir + "/s1/results.json", "-o",
+                                dir + "/m/results.json", "--no-html"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json merged = read_json(dir + "/m/results.json");
+  EXPECT_EQ(merged["matrix"]["cases"].size(), 2u);
+  EXPECT_EQ(merged["ranking"][0]["backend"], "scalar");
+  for (const char* scene : {"torus", "cone_pi"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/m/images/scalar/" + scene + ".png")) << scene;
+  r = test::run_flatmarch({"merge", dir + "/s1/results.json", "-o", dir + "/m/x.json"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("shard 2/2 is missing"), std::string::npos) << r.err;
+  // Shard 2 measured on another kind of machine, with its own shard 1: two machines compared.
+  json elsewhere = read_json(dir + "/s2/results.json");
+  elsewhere["fingerprint"]["cpu"]["model"] = "another CPU";
+  elsewhere["fingerprint"]["host"] = "elsewhere";
+  std::ofstream(dir + "/e2.json") << elsewhere.dump();
+  elsewhere = read_json(dir + "/s1/results.json");
+  elsewhere["fingerprint"]["cpu"]["model"] = "another CPU";
+  elsewhere["fingerprint"]["host"] = "elsewhere";
+  std::ofstream(dir + "/e1.json") << elsewhere.dump();
+  r = test::run_flatmarch({"merge", dir + "/s1/results.json", dir + "/s2/results.json",
+                           dir + "/e1.json", dir + "/e2.json", "-o", dir + "/c/results.json",
+                           "--no-html"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/c/results-elsewhere.json"));
+  EXPECT_EQ(read_json(dir + "/c/results-elsewhere.json")["fingerprint"]["cpu"]["model"],
+            "another CPU");
 }
 
 }  // namespace
