@@ -42,8 +42,7 @@ int main(int argc, char** argv) {
         params.method = method;
         reports::register_frame_benchmark(*backend, *scene, scene->camera, params, width, height, 0,
                                           0.0);
+        bench::note(reports::case_name(backend->name(), method, scene->name, width, height));
       }
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return bench::run();
 }

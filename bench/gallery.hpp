@@ -9,11 +9,16 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
+#include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "backends/backend.hpp"
+#include "reports/fingerprint.hpp"
 #include "reports/matrix.hpp"
+#include "reports/shard.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::bench {
@@ -56,12 +61,110 @@ inline bool parse_size(const std::string& text, int& width, int& height) {
          width <= 8192 && height <= 8192;
 }
 
-// What a benchmark program does first: keep freed frames and take Google Benchmark's flags.
-// False when a flag is unknown (it has been reported; exit with 2).
+// --- Sharded runs (issue 24): --shard=I/N runs shard I of N of the program's benchmarks, for a
+// scheduler to run apart; `flatmarch merge` puts the shards' --benchmark_out JSON together.
+
+// The program's run: its --shard, the names registered with add() or note() in order, and its
+// own flags as given (the shards of one run must be given the same).
+struct Run {
+  std::optional<reports::Shard> shard;
+  std::vector<std::string> names;
+  std::string flags;
+  bool writes_json = false;  // --benchmark_out given
+};
+inline Run& run_state() {
+  static Run run;
+  return run;
+}
+
+// Registers a benchmark as benchmark::RegisterBenchmark does, and records its name for --shard.
+template <class... Args>
+benchmark::internal::Benchmark* add(const std::string& name, Args&&... args) {
+  run_state().names.push_back(name);
+  return benchmark::RegisterBenchmark(name.c_str(), std::forward<Args>(args)...);
+}
+// Records the name of a benchmark registered otherwise (reports::register_frame_benchmark).
+inline void note(const std::string& name) {
+  run_state().names.push_back(name);
+}
+
+// What a benchmark program does first: keep freed frames, take --shard, and take Google
+// Benchmark's flags. False when a flag is unknown or --shard is not I/N (it has been reported;
+// exit with 2).
 inline bool begin(int& argc, char** argv) {
   keep_freed_frames();
+  for (int k = 1; k < argc; ++k) {
+    const std::string arg = argv[k];
+    if (arg.rfind("--shard=", 0) != 0 && arg.rfind("--benchmark_out", 0) != 0)
+      run_state().flags += (run_state().flags.empty() ? "" : " ") + arg;
+    if (arg.rfind("--benchmark_out=", 0) == 0) run_state().writes_json = true;
+  }
+  const auto flags = take_flags(argc, argv, {"shard"});
+  if (flags.count("shard")) {
+    run_state().shard = reports::parse_shard(flags.at("shard"));
+    if (!run_state().shard) {
+      std::fprintf(stderr, "%s: --shard=I/N with 1 <= I <= N <= 1000, not %s\n", argv[0],
+                   flags.at("shard").c_str());
+      return false;
+    }
+  }
   benchmark::Initialize(&argc, argv);
   return !benchmark::ReportUnrecognizedArguments(argc, argv);
+}
+
+// A name as a regular expression that matches it alone.
+inline std::string regex_escaped(const std::string& name) {
+  static const std::regex special(R"([.^$|()\[\]{}*+?\\])");
+  return std::regex_replace(name, special, R"(\$&)");
+}
+
+// Runs the registered benchmarks, or with --shard=I/N those of shard I: of the names that
+// --benchmark_filter selects, in the order registered, an equal share each (the programs'
+// benchmarks cost alike, a frame each at one size), the same split in every shard. The JSON
+// context then carries the machine's fingerprint and "flatmarch_shard" (the shard's record:
+// reports::shard_record) and "flatmarch_flags", for `flatmarch merge`. Returns the exit status.
+inline int run() {
+  Run& r = run_state();
+  if (!r.shard) {
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+  }
+  std::string filter = benchmark::GetBenchmarkFilter();
+  const bool negative = !filter.empty() && filter[0] == '-';
+  if (negative) filter.erase(0, 1);
+  const bool all = filter.empty() || filter == "." || filter == "all";
+  std::vector<std::string> cases;
+  try {
+    const std::regex selects(all ? "." : filter);
+    for (const std::string& name : r.names)
+      if (all || std::regex_search(name, selects) != negative) cases.push_back(name);
+  } catch (const std::regex_error& e) {
+    std::fprintf(stderr, "--benchmark_filter: not a regular expression: %s\n", e.what());
+    return 2;
+  }
+  if (static_cast<size_t>(r.shard->count) > cases.size()) {
+    std::fprintf(stderr, "--shard=%s: more shards than the run's %zu benchmarks\n",
+                 r.shard->text().c_str(), cases.size());
+    return 2;
+  }
+  const std::vector<double> costs(cases.size(), 1.0);
+  const std::vector<int> assignment = reports::assign_shards(costs, r.shard->count);
+  const nlohmann::json record = reports::shard_record(*r.shard, cases, assignment, costs);
+  std::string spec;
+  for (const auto& name : record["holds"])
+    spec += (spec.empty() ? "" : "|") + regex_escaped(name.get<std::string>());
+  std::fprintf(stderr, "shard %s holds %zu of the run's %zu benchmarks%s\n",
+               r.shard->text().c_str(), record["holds"].size(), cases.size(),
+               r.writes_json ? ""
+                             : " (give --benchmark_out=FILE: `flatmarch merge` puts the shards' "
+                               "JSON together)");
+  reports::add_to_benchmark_context(reports::hardware_fingerprint());
+  benchmark::AddCustomContext("flatmarch_shard", record.dump());
+  benchmark::AddCustomContext("flatmarch_flags", r.flags);
+  benchmark::RunSpecifiedBenchmarks("^(" + spec + ")(/|$)");
+  benchmark::Shutdown();
+  return 0;
 }
 
 // The gallery scenes (scenes/*.json), sorted by file name; pointers stay valid for benchmarks.

@@ -118,19 +118,17 @@ int main(int argc, char** argv) {
   for (const bench::PeerView& view : bench::kPeerViews) {
     peers.push_back(std::make_unique<Scene>(bench::peer_scene(view)));
     if (app)
-      benchmark::RegisterBenchmark(("peer/app/" + std::string(view.name)).c_str(), bench::app_frame,
-                                   app.get(), std::string(view.id), std::string(view.name),
-                                   peer_size)
+      bench::add(("peer/app/" + std::string(view.name)).c_str(), bench::app_frame, app.get(),
+                 std::string(view.id), std::string(view.name), peer_size)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
     for (const Backend* backend : available)
       for (Method method : kKernelMethods) {
         MarchParams params;
         params.method = method;
-        benchmark::RegisterBenchmark(
-            ("peer/" + backend->name() + "/" + view.name + "/" + to_string(method)).c_str(),
-            bench::frame, backend, peers.back().get(), bench::peer_camera(*peers.back()), params,
-            peer_size, std::string(view.name))
+        bench::add(("peer/" + backend->name() + "/" + view.name + "/" + to_string(method)).c_str(),
+                   bench::frame, backend, peers.back().get(), bench::peer_camera(*peers.back()),
+                   params, peer_size, std::string(view.name))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
       }
@@ -141,15 +139,12 @@ int main(int argc, char** argv) {
         for (const Backend* backend : available) {
           MarchParams params;
           params.method = method;
-          benchmark::RegisterBenchmark(
-              (backend->name() + "/" + to_string(method) + "/" + scene->name + "/" +
-               std::to_string(size.width) + "x" + std::to_string(size.height))
-                  .c_str(),
-              bench::frame, backend, scene.get(), scene->camera, params, size, std::string())
+          bench::add((backend->name() + "/" + to_string(method) + "/" + scene->name + "/" +
+                      std::to_string(size.width) + "x" + std::to_string(size.height))
+                         .c_str(),
+                     bench::frame, backend, scene.get(), scene->camera, params, size, std::string())
               ->Unit(benchmark::kMillisecond)
               ->UseRealTime();
         }
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return bench::run();
 }

@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
         MarchParams params;
         params.method = method;
         const std::string name = backend->name() + "/" + to_string(method) + "/f32/" + scene->name;
-        benchmark::RegisterBenchmark(name.c_str(), render_scene, backend.get(), scene.get(), params)
+        bench::add(name.c_str(), render_scene, backend.get(), scene.get(), params)
             ->Unit(benchmark::kMillisecond);
       }
   }
@@ -91,12 +91,9 @@ int main(int argc, char** argv) {
     for (Method method : {Method::sphere, Method::analytic})
       for (const auto& [label, extra] :
            {std::pair{"specialised", 0u}, std::pair{"generic", unused}})
-        benchmark::RegisterBenchmark(
-            ("specialisation/" + std::string(to_string(method)) + "/torus/" + label).c_str(),
-            extra_features, scene.get(), method, extra)
+        bench::add(("specialisation/" + std::string(to_string(method)) + "/torus/" + label).c_str(),
+                   extra_features, scene.get(), method, extra)
             ->Unit(benchmark::kMillisecond);
   }
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return bench::run();
 }

@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
     BackendOptions options;
     options.isa = isa;
     options.threads = threads;
-    benchmark::RegisterBenchmark(name.c_str(), simd_frame, scene, params, options)
+    bench::add(name.c_str(), simd_frame, scene, params, options)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   };
@@ -95,9 +95,8 @@ int main(int argc, char** argv) {
     for (const auto& scene : scenes) {
       const bool compared = scene->name == "l_shape" || scene->name == "double_pentagon";
       if (compared || scene->name == "cube" || scene->name == "staircase_32") {
-        benchmark::RegisterBenchmark(
-            (std::string("scalar/") + to_string(method) + "/" + scene->name).c_str(), scalar_frame,
-            scene.get(), case_params(*scene, method))
+        bench::add((std::string("scalar/") + to_string(method) + "/" + scene->name).c_str(),
+                   scalar_frame, scene.get(), case_params(*scene, method))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
       }
@@ -106,7 +105,5 @@ int main(int argc, char** argv) {
       if (!compared || cores > 1) simd_case(scene.get(), method, isas.front(), cores);
     }
   }
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return bench::run();
 }

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/gallery.hpp"
+
 extern char** environ;
 
 namespace {
@@ -55,8 +57,7 @@ void command(benchmark::State& state, std::vector<std::string> args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+  if (!flatmarch::bench::begin(argc, argv)) return 2;
   scratch = (std::filesystem::temp_directory_path() / "flatmarch_startup_bench").string();
   std::filesystem::create_directories(scratch);
   const std::string torus = kSource + "/scenes/torus.json";
@@ -71,12 +72,11 @@ int main(int argc, char** argv) {
        {"render", torus, "--backend", "opengl", "--size", "320x180", "-o", scratch + "/g.png"}},
       {"backends", {"backends"}}};
   for (const auto& [name, args] : cases)
-    benchmark::RegisterBenchmark(("startup/" + name).c_str(), command, args)
+    flatmarch::bench::add("startup/" + name, command, args)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime()
         ->MinTime(0.5);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
+  const int status = flatmarch::bench::run();
   std::filesystem::remove_all(scratch);
-  return 0;
+  return status;
 }

@@ -197,8 +197,8 @@ int main(int argc, char** argv) {
             {"rayMarchCamUp", {v.up.x, v.up.y, v.up.z}}}},
           {"w", size.width},
           {"h", size.height}};
-      benchmark::RegisterBenchmark(("web/peer/app/" + std::string(view.name) + "/" + at).c_str(),
-                                   bench::app, &web, page, request, std::string(view.name))
+      bench::add(("web/peer/app/" + std::string(view.name) + "/" + at).c_str(), bench::app, &web,
+                 page, request, std::string(view.name))
           ->Unit(benchmark::kMillisecond)
           ->UseManualTime();
     }
@@ -207,14 +207,12 @@ int main(int argc, char** argv) {
                                       {"camera", bench::camera_json(bench::peer_camera(scene))},
                                       {"w", size.width},
                                       {"h", size.height}};
-      benchmark::RegisterBenchmark(
+      bench::add(
           ("web/peer/webgl/" + std::string(view.name) + "/" + to_string(method) + "/" + at).c_str(),
           bench::ours, &web, page, request, std::string(view.name))
           ->Unit(benchmark::kMillisecond)
           ->UseManualTime();
     }
   }
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return bench::run();
 }

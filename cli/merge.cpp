@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -95,8 +96,9 @@ void add_merge(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "merge",
       "Put the shards of a sharded run back together: the JSON each shard of `flatmarch conform\n"
-      "--shard I/N`, `flatmarch sweep --shard I/N` or `flatmarch report --shard I/N` wrote, into\n"
-      "one results file with the cases in the run's order, as one unsharded run writes it.\n"
+      "--shard I/N`, `flatmarch sweep --shard I/N`, `flatmarch report --shard I/N` or a benchmark\n"
+      "program's --shard=I/N (its --benchmark_out) wrote, into one results file with the cases in\n"
+      "the run's order, as one unsharded run writes it.\n"
       "Checks that the files are the shards 1..N of one run (the same flatmarch build, machine,\n"
       "parameters and case list; none missing, none twice) and names the file and why when they\n"
       "are not (exit 2). Shards of a report also get what needs them all: the ranking, the\n"
@@ -106,7 +108,8 @@ void add_merge(CLI::App& app) {
       "OUTPUT-MACHINE.json each and a page comparing the machines.");
   struct Options {
     std::vector<std::string> files;
-    std::vector<std::string> galleries = {"scenes"};
+    // The run's scenes, named in its results: here, else in the source tree's gallery.
+    std::vector<std::string> galleries = {"scenes", FLATMARCH_SOURCE_DIR "/scenes"};
     std::string out, baseline, python = default_python();
     bool no_html = false;
   };
@@ -132,6 +135,12 @@ void add_merge(CLI::App& app) {
       std::stringstream text;
       text << in.rdbuf();
       json doc = json::parse(text.str(), nullptr, false);
+      if (doc.is_discarded()) {
+        // Google Benchmark writes NaN for a coefficient of variation of zeros (a counter that is
+        // 0 in every repetition), which JSON has not: read as null.
+        static const std::regex not_a_number(R"((:\s*)-?(NaN|nan|inf)\b)");
+        doc = json::parse(std::regex_replace(text.str(), not_a_number, "$1null"), nullptr, false);
+      }
       if (doc.is_discarded()) throw UsageError(file + ": not JSON");
       docs.emplace_back(file, std::move(doc));
     }
@@ -184,6 +193,14 @@ void add_merge(CLI::App& app) {
       }
       if (!o->baseline.empty() || o->no_html)
         throw UsageError("--baseline and --no-html are for the shards of `flatmarch report`");
+      if (reports::is_benchmark_shard(docs.front().second)) {
+        const json merged = reports::merge_benchmarks(docs);
+        write_json(out, merged);
+        std::fprintf(stderr, "merge: %zu shards of %s, %zu runs; wrote %s\n", docs.size(),
+                     merged["context"].value("executable", "a benchmark program").c_str(),
+                     merged["benchmarks"].size(), o->out.c_str());
+        return;
+      }
       const json merged = format == "flatmarch-sweep/1" ? reports::merge_sweep(docs)
                                                         : reports::merge_conformance(docs);
       write_json(out, merged);

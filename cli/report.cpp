@@ -53,7 +53,10 @@ struct StageProgress {
   std::string stage;
   std::unique_ptr<ProgressReporter> reporter;
   void operator()(const std::string& s, const std::string& line, int done, int total) {
-    if (quiet) return;
+    // What a shard holds and its estimated time, before it starts: said even when quiet, as
+    // the first line of a scheduler's log.
+    if (s == "shard") std::fprintf(stderr, "report: %s\n", line.c_str());
+    if (quiet || s == "shard") return;
     if (s != stage) {
       if (reporter) reporter->done();
       stage = s;

@@ -973,9 +973,25 @@ def one_machine(results, images, previous=None, previous_path=""):
             f"{esc(results['options']['size'])} (median of {results['options']['repetitions']} repetitions, "
             f"Google Benchmark), conformance frames {esc(results['options']['conform_size'])}, eps "
             f"{results['options']['eps']:g}, offset {results['options']['offset']:g}.</p>",
+            shards_note(results),
             "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t, html_ in sections if html_) + "</nav>"]
     body += [html_ for _, _, html_ in sections if html_]
     return PAGE.format(title="flatmarch report", body="\n".join(body))
+
+
+def shards_note(results):
+    """Where a merged run's shards ran, and each one's time against the estimate it began with."""
+    shards = results.get("shards")
+    if not shards:
+        return ""
+    hosts = ", ".join(esc(h) for h in results.get("hosts", []) if h) or "one host"
+    rows = [[str(k + 1), esc(s.get("host", "")), f"{sum(s.get('seconds', {}).values()):.0f} s",
+             f"{s.get('expected_seconds', 0):.0f} s"] for k, s in enumerate(shards)]
+    return (f"<p>Merged by <code>flatmarch merge</code> from {len(shards)} shards "
+            f"(<code>--shard I/{len(shards)}</code>) measured on {hosts}; the ranking, the "
+            "recommendation, the sweep's analysis and the gallery were made from all of them.</p>"
+            "<details><summary>Each shard's time against its estimate</summary>"
+            + table(["shard", "host", "measured", "estimated"], rows) + "</details>")
 
 
 # --- Machines compared.

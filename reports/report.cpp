@@ -75,16 +75,17 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
     const auto holds = [held](const std::string& key) { return held->count(key) > 0; };
     o.matrix.holds = o.sweep.holds = o.scaling.holds = holds;
     if (progress) {
-      char line[200];
-      std::snprintf(line, sizeof line,
-                    "shard %s holds %zu of the run's %zu cases, about %.0f s here by their "
-                    "expected costs (each shard's:",
-                    o.shard->text().c_str(), held->size(), names.size(),
-                    shard["costs"][static_cast<size_t>(o.shard->index - 1)].get<double>());
-      std::string text = line;
-      for (const json& c : shard["costs"])
-        text += " " + std::to_string(std::lround(c.get<double>()));
-      progress("shard", text + " s)", 0, 0);
+      const auto seconds = [](double s) {
+        char text[32];
+        std::snprintf(text, sizeof text, s < 10.0 ? "%.1f" : "%.0f", s);
+        return std::string(text);
+      };
+      std::string line = "shard " + o.shard->text() + " holds " + std::to_string(held->size()) +
+                         " of the run's " + std::to_string(names.size()) + " cases, about " +
+                         seconds(shard["costs"][static_cast<size_t>(o.shard->index - 1)]) +
+                         " s here by their expected costs (each shard's:";
+      for (const json& c : shard["costs"]) line += " " + seconds(c.get<double>());
+      progress("shard", line + " s)", 0, 0);
     }
   }
   json results = {{"format", "flatmarch-report/1"}, {"created", now_utc()}};

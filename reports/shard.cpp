@@ -190,4 +190,79 @@ json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
   return out;
 }
 
+bool is_benchmark_shard(const json& doc) {
+  return doc.is_object() && doc.contains("benchmarks") && doc.contains("context") &&
+         doc["context"].is_object() && doc["context"].contains("flatmarch_shard");
+}
+
+json merge_benchmarks(const std::vector<std::pair<std::string, json>>& files) {
+  // Each program's output in the form check_shards reads: its fingerprint from the context's
+  // fingerprint/... entries, its options the program and its flags.
+  std::vector<std::pair<std::string, json>> docs;
+  for (const auto& [file, doc] : files) {
+    if (!is_benchmark_shard(doc))
+      bad(file, "not the --benchmark_out JSON of a benchmark program run with --shard=I/N");
+    const json& context = doc["context"];
+    json flat = json::object();
+    for (const auto& [key, value] : context.items())
+      if (key.rfind("fingerprint/", 0) == 0)
+        flat["/" + key.substr(std::string("fingerprint/").size())] = value;
+    json shard = json::parse(context["flatmarch_shard"].get<std::string>(), nullptr, false);
+    if (shard.is_discarded() || !shard.is_object()) bad(file, "its flatmarch_shard is not JSON");
+    const std::string executable = context.value("executable", "");
+    docs.emplace_back(file, json{{"format", "flatmarch-bench/1"},
+                                 {"fingerprint", flat.empty() ? json::object() : flat.unflatten()},
+                                 {"options",
+                                  {{"program", executable.substr(executable.rfind('/') + 1)},
+                                   {"flags", context.value("flatmarch_flags", "")}}},
+                                 {"shard", shard}});
+  }
+  const auto shards = check_shards(docs, "flatmarch-bench/1", "a benchmark program");
+  // Runs by the position of their benchmark in the run's list (Google Benchmark adds settings
+  // to the registered name: "/repeats:3", "/manual_time", arguments).
+  const json& list = docs.front().second["shard"]["cases"];
+  const auto position = [&](const std::string& run_name) {
+    size_t best = list.size(), length = 0;
+    for (size_t k = 0; k < list.size(); ++k) {
+      const std::string& name = list[k].get_ref<const std::string&>();
+      if (name.size() >= length && run_name.rfind(name, 0) == 0 &&
+          (run_name.size() == name.size() || run_name[name.size()] == '/')) {
+        best = k;
+        length = name.size();
+      }
+    }
+    return best;
+  };
+  std::vector<std::pair<size_t, json>> runs;
+  for (const auto* entry : shards) {
+    const std::string& file = entry->first;
+    const json& doc = files[static_cast<size_t>(entry - docs.data())].second;
+    const json& holds = entry->second["shard"]["holds"];
+    std::vector<bool> ran(list.size(), false);
+    for (const json& run : doc["benchmarks"]) {
+      const size_t k = position(run.value("run_name", run.value("name", "")));
+      if (k == list.size() || std::find(holds.begin(), holds.end(), list[k]) == holds.end())
+        bad(file,
+            "holds a run of " + run.value("name", std::string("?")) + ", which is not its shard's");
+      ran[k] = true;
+      runs.emplace_back(k, run);
+    }
+    for (const json& name : holds)
+      if (!ran[position(name.get<std::string>())])
+        bad(file, "has no run of " + name.get<std::string>() +
+                      ", which its shard holds (an interrupted run?)");
+  }
+  std::stable_sort(runs.begin(), runs.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  json out = {
+      {"context", files[static_cast<size_t>(shards.front() - docs.data())].second["context"]},
+      {"benchmarks", json::array()}};
+  out["context"].erase("flatmarch_shard");
+  std::string from;
+  for (const auto& [file, doc] : files) from += (from.empty() ? "" : " ") + file;
+  out["context"]["flatmarch_merged_from"] = from;
+  for (auto& [k, run] : runs) out["benchmarks"].push_back(std::move(run));
+  return out;
+}
+
 }  // namespace flatmarch::reports

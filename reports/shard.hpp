@@ -71,4 +71,16 @@ nlohmann::json merged_header(const std::vector<std::pair<std::string, nlohmann::
 // cases in the run's order. Throws std::invalid_argument naming the file and why.
 nlohmann::json merge_conformance(const std::vector<std::pair<std::string, nlohmann::json>>& files);
 
+// Merges the --benchmark_out JSON of a benchmark program's shards (--shard=I/N; bench/gallery.hpp
+// bench::run) into one Google Benchmark document: the context of shard 1 (less the shard), every
+// run in the order the program registered its benchmarks, "flatmarch_merged_from" in the context.
+// Checks as check_shards: the same program, flags, build and machine (the context's fingerprint),
+// case list and N; none missing, none twice; and that each shard ran its benchmarks. Throws
+// std::invalid_argument naming the file and why.
+nlohmann::json merge_benchmarks(const std::vector<std::pair<std::string, nlohmann::json>>& files);
+
+// Whether a document is a benchmark program's sharded output (Google Benchmark's JSON with
+// "flatmarch_shard" in its context).
+bool is_benchmark_shard(const nlohmann::json& doc);
+
 }  // namespace flatmarch::reports

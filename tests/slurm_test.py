@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""A sharded conformance run on a real Slurm (issue 24): a single-node cluster on localhost,
-configured in a temporary folder (munged with its own key and socket, slurmctld and slurmd on
-free ports), takes ci/slurm/submit.sh's job array of three `conform --shard I/3` tasks and the
-merge job that depends on it; the merged results must equal an unsharded run's, case by case
-(all but the seconds each took).
+"""Sharded runs on a real Slurm (issue 24): a single-node cluster on localhost, configured in a
+temporary folder (munged with its own key and socket, slurmctld and slurmd on free ports), takes
+ci/slurm/submit.sh's job arrays of three `conform --shard I/3` and three `report --shard I/3`
+tasks (small), each with the merge job that depends on it; each merged result must equal an
+unsharded run's in every field a rerun measures alike (all but the timings), and the report's
+merge must have drawn the recommended gallery and the page.
 
     slurm_test.py FLATMARCH SOURCE OUT   exit 0: passed, 1: failed, 77: skipped (no Slurm or
                                          munge here, not root, or the cluster would not start)
@@ -20,6 +21,20 @@ import time
 
 SKIP = 77
 PROGRAMS = ["munged", "munge", "slurmctld", "slurmd", "sbatch", "squeue", "sinfo", "scontrol"]
+
+
+def deterministic_report(doc):
+    """A report's fields that every run measures alike: the matrix's verdicts and step counts,
+    the sweep's points, re-checks and recommended points, the recommended parameters."""
+    cases = [{k: v for k, v in c.items() if k not in ("time_ms", "time_samples_ms", "counters")}
+             | {"steps": c["counters"]["steps_mean"], "crossings": c["counters"]["crossings_mean"]}
+             for c in doc["matrix"]["cases"]]
+    points = [{k: v for k, v in p.items() if k != "time_ms"} for p in doc["sweep"]["points"]]
+    picks = [(g["surface_type"], g["method"], g["precision"],
+              g["recommended"] and (g["recommended"]["eps"], g["recommended"]["offset"]))
+             for g in doc["sweep"]["analysis"]]
+    return (cases, points, doc["sweep"]["confirmations"], picks,
+            doc["recommendation"].get("parameters"))
 
 
 def free_port():
@@ -129,39 +144,61 @@ def main():
         if why:
             print("skipped:", why)
             return SKIP
-        options = ["--backend", "scalar", "--method", "sphere", "--method", "analytic",
-                   "--size", "48x27", "--gallery", os.path.join(source, "scenes")]
-        for s in ("torus", "l_shape", "mirror_pentagon", "cone_pi"):
-            options += ["--scene", s]
         env["FLATMARCH"] = flatmarch
-        r = subprocess.run([os.path.join(source, "ci", "slurm", "submit.sh"), "3",
-                            os.path.join(out, "sharded"), *options],
-                           env=env, capture_output=True, text=True, timeout=120)
-        if r.returncode != 0:
-            print("FAILED: submit.sh:", r.stderr)
-            return 1
-        print(r.stdout.strip())
-        merge = r.stdout.split()[-1]
-        done = wait_for("the merge", lambda: subprocess.run(
-            ["squeue", "-h", "-j", merge], env=env, capture_output=True, text=True).stdout.strip() == "",
-            600)
-        state = subprocess.run(["scontrol", "show", "job", merge], env=env, capture_output=True,
-                               text=True).stdout
-        merged = os.path.join(out, "sharded", "conform.json")
-        if not done or "JobState=COMPLETED" not in state or not os.path.exists(merged):
-            print("FAILED: the merge job did not complete:", state[:400])
-            for log in sorted(os.listdir(os.path.join(out, "sharded"))):
-                if log.endswith(".log"):
-                    print(log, open(os.path.join(out, "sharded", log)).read()[-600:])
-            return 1
-        whole = os.path.join(out, "whole.json")
-        subprocess.run([flatmarch, "conform", *options, "--json", whole, "-q"], check=True,
-                       capture_output=True, timeout=600)
-        a, b = json.load(open(merged)), json.load(open(whole))
-        if deterministic(a["cases"]) != deterministic(b["cases"]) or a["options"] != b["options"]:
-            print("FAILED: the merged results differ from the unsharded run's")
-            return 1
-        print(f"{len(a['cases'])} cases from 3 shards on Slurm equal the unsharded run's")
+        gallery = ["--gallery", os.path.join(source, "scenes")]
+        scenes = []
+        for s in ("torus", "l_shape", "mirror_pentagon", "cone_pi"):
+            scenes += ["--scene", s]
+        conform = ["--backend", "scalar", "--method", "sphere", "--method", "analytic",
+                   "--size", "48x27", *gallery, *scenes]
+        # The main job, small: the matrix and the sweep (its re-checks and recommendation too).
+        report = ["--backend", "scalar", "--backend", "simd", "--method", "sphere", "--method",
+                  "analytic", "--size", "32x18", "--conform-size", "32x18", "--sweep-size",
+                  "16x9", "--repetitions", "2", "--min-time", "0.001", "--no-scaling", "-q",
+                  *gallery, *scenes]
+        for job, options in (("conform", conform), ("report", report)):
+            sharded = os.path.join(out, job)
+            r = subprocess.run([os.path.join(source, "ci", "slurm", "submit.sh"), job, "3",
+                                sharded, *options],
+                               env=env, capture_output=True, text=True, timeout=120)
+            if r.returncode != 0:
+                print(f"FAILED: submit.sh {job}:", r.stderr)
+                return 1
+            print(job, r.stdout.strip())
+            merge = r.stdout.split()[-1]
+            done = wait_for("the merge", lambda: subprocess.run(
+                ["squeue", "-h", "-j", merge], env=env, capture_output=True,
+                text=True).stdout.strip() == "", 600)
+            state = subprocess.run(["scontrol", "show", "job", merge], env=env,
+                                   capture_output=True, text=True).stdout
+            merged = os.path.join(sharded, "conform.json" if job == "conform" else "results.json")
+            if not done or "JobState=COMPLETED" not in state or not os.path.exists(merged):
+                print(f"FAILED: the {job} merge job did not complete:", state[:400])
+                for log in sorted(os.listdir(sharded)):
+                    if log.endswith(".log"):
+                        print(log, open(os.path.join(sharded, log)).read()[-600:])
+                return 1
+            whole = os.path.join(out, job + "-whole")
+            args = ["--json", whole + ".json", "-q"] if job == "conform" else ["-o", whole, "--no-html"]
+            subprocess.run([flatmarch, job, *options, *args], check=True, capture_output=True,
+                           timeout=600)
+            a = json.load(open(merged))
+            b = json.load(open(whole + ".json" if job == "conform" else whole + "/results.json"))
+            if job == "conform":
+                same = deterministic(a["cases"]) == deterministic(b["cases"])
+            else:
+                same = (deterministic_report(a) == deterministic_report(b)
+                        and os.path.exists(os.path.join(sharded, "index.html"))
+                        and os.path.exists(os.path.join(sharded, "images", "recommended")))
+                log = open(os.path.join(sharded, "shard-1.log")).read()
+                if "report: shard 1/3 holds" not in log:
+                    print("FAILED: shard 1's log does not begin with what it holds:", log[:400])
+                    return 1
+            if not same or a["options"] != b["options"]:
+                print(f"FAILED: the merged {job} results differ from the unsharded run's")
+                return 1
+            count = len(a["cases"]) if job == "conform" else len(a["matrix"]["cases"])
+            print(f"{job}: {count} cases from 3 shards on Slurm equal the unsharded run's")
         return 0
     finally:
         stop_cluster(t)

@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""The CI matrix of sharded runs (.github/workflows/bench.yml, issue 24), run here: its jobs in the
-order their `needs` give, each matrix entry in a workspace of its own (the checkout: this source
-tree, with the build folder under test as its build/), every `run` step through bash as GitHub
-runs it (`${{ matrix.* }}` and `${{ strategy.job-total }}` filled in, the workflow's env with
-CONFORM_OPTIONS made small), artifacts uploaded and downloaded through a folder. The build step is
-left out (the tree is built, and a configure would touch the build under test). The merged
-results must equal an unsharded run's, case by case (all but the seconds each took).
+"""The CI matrix of sharded reports (.github/workflows/bench.yml, issue 24), run here: its jobs in
+the order their `needs` give, each matrix entry in a workspace of its own (the checkout: this
+source tree, with the build folder under test as its build/), every `run` step through bash as
+GitHub runs it (`${{ matrix.* }}` and `${{ strategy.job-total }}` filled in; the workflow's env
+with REPORT_OPTIONS made small and BASELINE a baseline that an unsharded run of those options
+wrote), artifacts (the Pages one too) uploaded and downloaded through a folder, the deployment
+checked to find the page. The build step is left out (the tree is built, and a configure would
+touch the build under test). The merged results must pass the gate and equal the unsharded
+run's in every field a rerun measures alike (all but the timings).
 
     workflow_test.py BUILD_DIR SOURCE OUT   exit 0: passed, 1: failed
 """
@@ -21,8 +23,23 @@ import sys
 
 import yaml
 
-SMALL = ("--backend scalar --method sphere --method analytic --size 48x27 "
+SMALL = ("--backend scalar --backend simd --method sphere --method analytic --size 32x18 "
+         "--conform-size 32x18 --sweep-size 16x9 --repetitions 2 --min-time 0.001 --no-scaling "
          "--scene torus --scene l_shape --scene mirror_pentagon --scene cone_pi")
+
+
+def deterministic(doc):
+    """A report's fields that every run measures alike: the matrix's verdicts and step counts,
+    the sweep's points, re-checks and recommended points, the recommended parameters."""
+    cases = [{k: v for k, v in c.items() if k not in ("time_ms", "time_samples_ms", "counters")}
+             | {"steps": c["counters"]["steps_mean"], "crossings": c["counters"]["crossings_mean"]}
+             for c in doc["matrix"]["cases"]]
+    points = [{k: v for k, v in p.items() if k != "time_ms"} for p in doc["sweep"]["points"]]
+    picks = [(g["surface_type"], g["method"], g["precision"],
+              g["recommended"] and (g["recommended"]["eps"], g["recommended"]["offset"]))
+             for g in doc["sweep"]["analysis"]]
+    return (cases, points, doc["sweep"]["confirmations"], picks,
+            doc["recommendation"].get("parameters"))
 
 
 def job_order(jobs):
@@ -59,14 +76,21 @@ def fill(text, matrix, total):
 
 def main():
     build, source, out = (os.path.abspath(a) for a in sys.argv[1:4])
+    flatmarch = os.path.join(build, "cli", "flatmarch")
     workflow = yaml.safe_load(open(os.path.join(source, ".github", "workflows", "bench.yml")))
     shutil.rmtree(out, ignore_errors=True)
     artifacts = os.path.join(out, "artifacts")
     os.makedirs(artifacts)
+    # The unsharded run first: the merge is held to it, and gated against its baseline.
+    whole = os.path.join(out, "whole")
+    subprocess.run([flatmarch, "report", *SMALL.split(), "-q", "--no-html", "-o", whole,
+                    "--write-baseline", os.path.join(whole, "baseline.json")],
+                   cwd=source, check=True, capture_output=True, timeout=900)
     env = dict(os.environ, **{k: str(v) for k, v in workflow.get("env", {}).items()})
-    env["CONFORM_OPTIONS"] = SMALL
+    env["REPORT_OPTIONS"] = SMALL
+    env["BASELINE"] = os.path.join(whole, "baseline.json")
     jobs = workflow["jobs"]
-    workspace = None
+    merged = published = None
     for name in job_order(jobs):
         job = jobs[name]
         runs = list(entries(job))
@@ -80,22 +104,34 @@ def main():
                         if entry not in (".git", "build"):
                             os.symlink(os.path.join(source, entry), os.path.join(workspace, entry))
                     os.symlink(build, os.path.join(workspace, "build"))
-                elif uses.startswith("actions/upload-artifact@"):
-                    into = os.path.join(artifacts, fill(w["name"], matrix, len(runs)))
+                elif uses.startswith(("actions/upload-artifact@", "actions/upload-pages-artifact@")):
+                    pages = uses.startswith("actions/upload-pages-artifact@")
+                    into = os.path.join(artifacts, "github-pages" if pages
+                                        else fill(w["name"], matrix, len(runs)))
                     os.makedirs(into, exist_ok=True)
                     files = glob.glob(os.path.join(workspace, fill(w["path"], matrix, len(runs))))
                     if not files:
                         print(f"FAILED: {name} {matrix}: nothing to upload at {w['path']}")
                         return 1
-                    for f in files:
-                        shutil.copy(f, into)
+                    for f in files:  # a folder's contents, as upload-artifact takes them
+                        if os.path.isdir(f):
+                            shutil.copytree(f, into, dirs_exist_ok=True)
+                        else:
+                            shutil.copy(f, into)
                 elif uses.startswith("actions/download-artifact@"):
                     into = os.path.join(workspace, w["path"])
-                    os.makedirs(into, exist_ok=True)
                     for a in sorted(os.listdir(artifacts)):
                         if fnmatch.fnmatch(a, w.get("pattern", "*")):
-                            for f in os.listdir(os.path.join(artifacts, a)):
-                                shutil.copy(os.path.join(artifacts, a, f), into)
+                            # Each artifact in a folder of its name, unless merge-multiple.
+                            to = into if w.get("merge-multiple") else os.path.join(into, a)
+                            shutil.copytree(os.path.join(artifacts, a), to, dirs_exist_ok=True)
+                elif uses.startswith("actions/deploy-pages@"):
+                    site = os.path.join(artifacts, "github-pages")
+                    if not os.path.exists(os.path.join(site, "index.html")):
+                        print(f"FAILED: {name}: no page to deploy (no index.html in the Pages artifact)")
+                        return 1
+                    published = site
+                    print(f"{name}: deploy: the page and {len(os.listdir(site))} entries")
                 elif uses:
                     print(f"FAILED: {name}: a step the test cannot run here: {uses}")
                     return 1
@@ -110,19 +146,23 @@ def main():
                     if r.returncode != 0:
                         print(f"FAILED: {r.stdout[-800:]}{r.stderr[-800:]}")
                         return 1
-    merged = os.path.join(workspace, "results", "conform.json")
-    if not os.path.exists(merged):
-        print("FAILED: the last job wrote no results/conform.json")
+                    if "flatmarch merge" in script:
+                        merged = os.path.join(workspace, "site", "results.json")
+    if not merged or not os.path.exists(merged):
+        print("FAILED: no job merged the shards into site/results.json")
         return 1
-    whole = os.path.join(out, "whole.json")
-    subprocess.run([os.path.join(build, "cli", "flatmarch"), "conform", *SMALL.split(), "--json",
-                    whole, "-q"], cwd=source, check=True, capture_output=True, timeout=900)
-    strip = lambda doc: [{k: v for k, v in c.items() if k != "seconds"} for c in doc["cases"]]
-    a, b = json.load(open(merged)), json.load(open(whole))
-    if strip(a) != strip(b):
+    if not published:
+        print("FAILED: no job published the page")
+        return 1
+    a, b = json.load(open(merged)), json.load(open(os.path.join(whole, "results.json")))
+    if deterministic(a) != deterministic(b) or a["options"] != b["options"]:
         print("FAILED: the merged results differ from an unsharded run's")
         return 1
-    print(f"{len(a['cases'])} cases merged from {len(a['merged_from'])} shards equal the unsharded run's")
+    if not a["regression"]["checked"] or a["regression"]["regressions"]:
+        print("FAILED: the gate did not pass:", json.dumps(a["regression"])[:400])
+        return 1
+    print(f"{len(a['matrix']['cases'])} matrix cases merged from {len(a['merged_from'])} shards "
+          f"equal the unsharded run's; gated against its baseline; the page published")
     return 0
 
 
