@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
         reports::register_frame_benchmark(*backend, *scene, scene->camera, params, width, height, 0,
                                           0.0);
         bench::note(reports::case_name(backend->name(), method, scene->name, width, height));
+        bench::cost(reports::frame_cost(backend->name(), to_string(method), width, height));
       }
   return bench::run();
 }

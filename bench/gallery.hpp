@@ -69,6 +69,7 @@ inline bool parse_size(const std::string& text, int& width, int& height) {
 struct Run {
   std::optional<reports::Shard> shard;
   std::vector<std::string> names;
+  std::vector<double> costs;  // of each name: expected seconds, or 1 where none was given
   std::string flags;
   bool writes_json = false;  // --benchmark_out given
 };
@@ -81,11 +82,18 @@ inline Run& run_state() {
 template <class... Args>
 benchmark::internal::Benchmark* add(const std::string& name, Args&&... args) {
   run_state().names.push_back(name);
+  run_state().costs.push_back(1.0);
   return benchmark::RegisterBenchmark(name.c_str(), std::forward<Args>(args)...);
 }
 // Records the name of a benchmark registered otherwise (reports::register_frame_benchmark).
 inline void note(const std::string& name) {
   run_state().names.push_back(name);
+  run_state().costs.push_back(1.0);
+}
+// The expected cost of the benchmark registered last (reports::frame_cost of its frame), by
+// which --shard balances the shards; without it every benchmark costs alike.
+inline void cost(double seconds) {
+  if (!run_state().costs.empty()) run_state().costs.back() = seconds;
 }
 
 // What a benchmark program does first: keep freed frames, take --shard, and take Google
@@ -119,8 +127,8 @@ inline std::string regex_escaped(const std::string& name) {
 }
 
 // Runs the registered benchmarks, or with --shard=I/N those of shard I: of the names that
-// --benchmark_filter selects, in the order registered, an equal share each (the programs'
-// benchmarks cost alike, a frame each at one size), the same split in every shard. The JSON
+// --benchmark_filter selects, in the order registered, split by their cost (cost(); alike where
+// none was given), the same split in every shard. The JSON
 // context then carries the machine's fingerprint and "flatmarch_shard" (the shard's record:
 // reports::shard_record) and "flatmarch_flags", for `flatmarch merge`. Returns the exit status.
 inline int run() {
@@ -135,10 +143,14 @@ inline int run() {
   if (negative) filter.erase(0, 1);
   const bool all = filter.empty() || filter == "." || filter == "all";
   std::vector<std::string> cases;
+  std::vector<double> costs;
   try {
     const std::regex selects(all ? "." : filter);
-    for (const std::string& name : r.names)
-      if (all || std::regex_search(name, selects) != negative) cases.push_back(name);
+    for (size_t k = 0; k < r.names.size(); ++k)
+      if (all || std::regex_search(r.names[k], selects) != negative) {
+        cases.push_back(r.names[k]);
+        costs.push_back(r.costs[k]);
+      }
   } catch (const std::regex_error& e) {
     std::fprintf(stderr, "--benchmark_filter: not a regular expression: %s\n", e.what());
     return 2;
@@ -148,7 +160,6 @@ inline int run() {
                  r.shard->text().c_str(), cases.size());
     return 2;
   }
-  const std::vector<double> costs(cases.size(), 1.0);
   const std::vector<int> assignment = reports::assign_shards(costs, r.shard->count);
   const nlohmann::json record = reports::shard_record(*r.shard, cases, assignment, costs);
   std::string spec;

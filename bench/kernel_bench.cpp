@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
         const std::string name = backend->name() + "/" + to_string(method) + "/f32/" + scene->name;
         bench::add(name.c_str(), render_scene, backend.get(), scene.get(), params)
             ->Unit(benchmark::kMillisecond);
+        bench::cost(reports::frame_cost(backend->name(), to_string(method), kWidth, kHeight));
       }
   }
   for (const auto& scene : scenes) {

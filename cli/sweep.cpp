@@ -95,8 +95,8 @@ void add_sweep(CLI::App& app) {
       const auto held =
           std::make_shared<std::set<std::string>>(shard["holds"].begin(), shard["holds"].end());
       o->sweep.holds = [held](const std::string& key) { return held->count(key) > 0; };
-      if (!o->quiet)
-        std::fprintf(stderr,
+      // Said even when quiet: the first line of a scheduler's log.
+      std::fprintf(stderr,
                      "sweep: shard %s holds %zu of the run's %zu groups, about %.0f s here by "
                      "their expected costs\n",
                      s.text().c_str(), held->size(), names.size(),
@@ -113,8 +113,6 @@ void add_sweep(CLI::App& app) {
     result["fingerprint"] = reports::hardware_fingerprint();
     result["options"]["scenes"] = json::array();
     for (const Scene& s : scenes) result["options"]["scenes"].push_back(s.name);
-    result["options"]["methods"] = json::array();
-    for (Method m : o->sweep.methods) result["options"]["methods"].push_back(to_string(m));
     result["options"]["precisions"] = json::array();
     for (Precision p : o->sweep.precisions)
       result["options"]["precisions"].push_back(p == Precision::f32 ? "f32" : "f64");

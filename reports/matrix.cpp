@@ -323,7 +323,7 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
         if (progress)
           progress("conformance " + name + (c.contains("error") ? ": error" : ""), ++done, steps);
       }
-  if (o.timing) {
+  if (o.timing && total > 0) {  // a shard may hold no matrix case
     out["benchmarks"] = run_registered_benchmarks([&](const std::string& name) {
       if (progress) progress("timed " + name, ++done, steps);
     });

@@ -106,8 +106,10 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
       {"offset", o.matrix.params.offset},
       {"max_steps", o.matrix.params.max_steps},
       {"max_distance", o.matrix.params.max_distance},
-      {"scenes", json::array()}};
+      {"scenes", json::array()},
+      {"methods", json::array()}};
   for (const Scene& s : scenes) results["options"]["scenes"].push_back(s.name);
+  for (Method m : o.matrix.methods) results["options"]["methods"].push_back(to_string(m));
   conformance::Suite suite;
   auto started = std::chrono::steady_clock::now();
   // Seconds since the last call: the time each stage took.
@@ -644,7 +646,7 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
       out["matrix"]["cases"].push_back(matrix[key.get<std::string>()]);
   if (!sweep_options.is_null())
     out["sweep"] = merged_sweep(sweep_options, std::move(points), std::move(confirmations),
-                                first["options"]["scenes"], first["registry"]["methods"]);
+                                first["options"]["scenes"], sweep_options["methods"]);
   if (first.contains("scaling")) {
     const auto key = [&](const json& s) {
       return position.at("scaling/" + s["family"].get<std::string>() + "/" +

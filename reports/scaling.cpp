@@ -156,9 +156,11 @@ json run_scaling(const ScalingOptions& o,
           ++total;
         }
   int done = 0;
-  out["benchmarks"] = run_registered_benchmarks([&](const std::string& name) {
-    if (progress) progress("timed " + name, ++done, total);
-  });
+  // A shard may hold no series: then nothing is timed.
+  out["benchmarks"] = total == 0 ? json{{"context", json::object()}, {"benchmarks", json::array()}}
+                                 : run_registered_benchmarks([&](const std::string& name) {
+                                     if (progress) progress("timed " + name, ++done, total);
+                                   });
   const std::map<std::string, Timing> t = timings(out["benchmarks"]);
   for (const Series& s : series)
     for (const auto& b : backends)

@@ -237,8 +237,10 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
       {"confirm_size",
        o.confirm_scale > 1 ? json(std::to_string(cw) + "x" + std::to_string(ch)) : json(nullptr)},
       {"repetitions", o.repetitions},
+      {"methods", json::array()},
       {"max_steps", o.params.max_steps},
       {"max_distance", o.params.max_distance}};
+  for (Method m : o.methods) options["methods"].push_back(to_string(m));
   return {{"options", options},
           {"points", points},
           {"confirmations", confirmations},
@@ -285,11 +287,10 @@ json merge_sweep(const std::vector<std::pair<std::string, json>>& files) {
                                     ", which its shard holds (an interrupted run?)");
   }
   const json& first = files.front().second;
-  json methods = json::array();
-  for (Method m : kKernelMethods) methods.push_back(to_string(m));
   json out = merged_header(files);
   out.update(merged_sweep(first["options"], std::move(points), std::move(confirmations),
-                          first["options"].value("scenes", json::array()), methods));
+                          first["options"].value("scenes", json::array()),
+                          first["options"].value("methods", json::array())));
   return out;
 }
 

@@ -168,7 +168,7 @@ TEST_F(ShardedConform, AWrongSetFailsNamingTheFileAndWhy) {
 reports::ReportOptions small_report() {
   reports::ReportOptions r;
   r.matrix.backends = {"scalar", "simd"};
-  r.matrix.methods = {Method::sphere, Method::analytic};
+  r.matrix.methods = {Method::analytic, Method::sphere};  // not the registry's order
   r.matrix.width = r.matrix.conform_width = 32;
   r.matrix.height = r.matrix.conform_height = 18;
   r.matrix.repetitions = 2;
@@ -378,6 +378,63 @@ TEST(ShardedReport, ReportShardsMergeOnTheCommandLine) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/c/results-elsewhere.json"));
   EXPECT_EQ(read_json(dir + "/c/results-elsewhere.json")["fingerprint"]["cpu"]["model"],
             "another CPU");
+}
+
+// `sweep --shard I/N`: whole groups (surface type x method) per shard; the merge makes the
+// analysis again and equals an unsharded sweep.
+TEST(ShardedSweep, MergedShardsEqualAnUnshardedSweep) {
+  const std::string dir = test::make_temp_dir();
+  const auto sweep = [&](const std::string& file, std::vector<std::string> more) {
+    std::vector<std::string> args = {
+        "sweep",         "--scene",   "torus",
+        "--scene",       "cone_pi",   "--scene",
+        "mirror_square", "--gallery", std::string(FLATMARCH_SOURCE_DIR) + "/scenes",
+        "--method",      "analytic",  "--method",
+        "sphere",        "--eps",     "1e-2",
+        "--eps",         "1e-3",      "--eps",
+        "1e-4",          "--size",    "16x9",
+        "--repetitions", "1",         "-q",
+        "--json",        file};
+    args.insert(args.end(), more.begin(), more.end());
+    return test::run_flatmarch(args, 300.0);
+  };
+  ASSERT_EQ(sweep(dir + "/whole.json", {}).exit_code, 0);
+  std::vector<std::string> merge = {"merge"};
+  for (const char* i : {"1", "2", "3"}) {
+    const auto r = sweep(dir + "/s" + i + ".json", {"--shard", std::string(i) + "/3"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("sweep: shard " + std::string(i) + "/3 holds"), std::string::npos);
+    merge.push_back(dir + "/s" + i + ".json");
+  }
+  merge.insert(merge.end(), {"-o", dir + "/merged.json"});
+  const auto r = test::run_flatmarch(merge);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json whole = read_json(dir + "/whole.json"), merged = read_json(dir + "/merged.json");
+  const auto strip = [](json doc) {
+    for (json& p : doc["points"]) p.erase("time_ms");
+    for (json& g : doc["analysis"]) {
+      g.erase("pareto");
+      for (json& c : g["grid"]) c.erase("time_ms");
+      if (!g["recommended"].is_null()) g["recommended"].erase("time_ms");
+    }
+    return json{doc["points"], doc["confirmations"], doc["analysis"]};
+  };
+  ASSERT_EQ(whole["analysis"].size(), 12u);  // 3 surface types x 2 methods x f32, f64
+  EXPECT_EQ(strip(merged), strip(whole));
+  EXPECT_EQ(merged["options"], whole["options"]);
+  // A conform shard among sweep shards, and a shard missing.
+  json other = read_json(dir + "/s2.json");
+  other["format"] = "flatmarch-conform/1";
+  std::ofstream(dir + "/other.json") << other.dump();
+  auto wrong = test::run_flatmarch(
+      {"merge", dir + "/s1.json", dir + "/other.json", dir + "/s3.json", "-o", dir + "/w.json"});
+  EXPECT_EQ(wrong.exit_code, 2);
+  EXPECT_NE(wrong.err.find(dir + "/other.json: not the results of `flatmarch sweep`"),
+            std::string::npos)
+      << wrong.err;
+  wrong = test::run_flatmarch({"merge", dir + "/s1.json", dir + "/s3.json", "-o", dir + "/w.json"});
+  EXPECT_EQ(wrong.exit_code, 2);
+  EXPECT_NE(wrong.err.find("shard 2/3 is missing"), std::string::npos) << wrong.err;
 }
 
 }  // namespace

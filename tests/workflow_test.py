@@ -23,23 +23,11 @@ import sys
 
 import yaml
 
+from sharded_results import deterministic_report
+
 SMALL = ("--backend scalar --backend simd --method sphere --method analytic --size 32x18 "
          "--conform-size 32x18 --sweep-size 16x9 --repetitions 2 --min-time 0.001 --no-scaling "
          "--scene torus --scene l_shape --scene mirror_pentagon --scene cone_pi")
-
-
-def deterministic(doc):
-    """A report's fields that every run measures alike: the matrix's verdicts and step counts,
-    the sweep's points, re-checks and recommended points, the recommended parameters."""
-    cases = [{k: v for k, v in c.items() if k not in ("time_ms", "time_samples_ms", "counters")}
-             | {"steps": c["counters"]["steps_mean"], "crossings": c["counters"]["crossings_mean"]}
-             for c in doc["matrix"]["cases"]]
-    points = [{k: v for k, v in p.items() if k != "time_ms"} for p in doc["sweep"]["points"]]
-    picks = [(g["surface_type"], g["method"], g["precision"],
-              g["recommended"] and (g["recommended"]["eps"], g["recommended"]["offset"]))
-             for g in doc["sweep"]["analysis"]]
-    return (cases, points, doc["sweep"]["confirmations"], picks,
-            doc["recommendation"].get("parameters"))
 
 
 def job_order(jobs):
@@ -155,7 +143,7 @@ def main():
         print("FAILED: no job published the page")
         return 1
     a, b = json.load(open(merged)), json.load(open(os.path.join(whole, "results.json")))
-    if deterministic(a) != deterministic(b) or a["options"] != b["options"]:
+    if deterministic_report(a) != deterministic_report(b) or a["options"] != b["options"]:
         print("FAILED: the merged results differ from an unsharded run's")
         return 1
     if not a["regression"]["checked"] or a["regression"]["regressions"]:
