@@ -97,10 +97,10 @@ void add_sweep(CLI::App& app) {
       o->sweep.holds = [held](const std::string& key) { return held->count(key) > 0; };
       // Said even when quiet: the first line of a scheduler's log.
       std::fprintf(stderr,
-                     "sweep: shard %s holds %zu of the run's %zu groups, about %.0f s here by "
-                     "their expected costs\n",
-                     s.text().c_str(), held->size(), names.size(),
-                     shard["costs"][static_cast<size_t>(s.index - 1)].get<double>());
+                   "sweep: shard %s holds %zu of the run's %zu groups, about %.0f s here by "
+                   "their expected costs\n",
+                   s.text().c_str(), held->size(), names.size(),
+                   shard["costs"][static_cast<size_t>(s.index - 1)].get<double>());
     }
     conformance::Suite suite;
     ProgressReporter progress("sweep", o->quiet);
