@@ -26,6 +26,7 @@
 #include "backends/webgl/chromium.hpp"
 #include "bench/gallery.hpp"
 #include "bench/peer_app.hpp"
+#include "scene/inspect.hpp"
 #include "web/page.hpp"
 
 namespace flatmarch::bench {
@@ -66,14 +67,6 @@ struct Web {
 double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
   return v[v.size() / 2];
-}
-
-json camera_json(const Camera& c) {
-  return {{"polygon", c.polygon},
-          {"position", {c.position.x, c.position.y, c.position.z}},
-          {"yaw_deg", c.yaw_deg},
-          {"pitch_deg", c.pitch_deg},
-          {"fov_deg", c.fov_deg}};
 }
 
 void timed(benchmark::State& state, Web* web, const std::string& page, const json& request) {
@@ -203,10 +196,11 @@ int main(int argc, char** argv) {
           ->UseManualTime();
     }
     for (const Method method : kKernelMethods) {
-      const nlohmann::json request = {{"method", to_string(method)},
-                                      {"camera", bench::camera_json(bench::peer_camera(scene))},
-                                      {"w", size.width},
-                                      {"h", size.height}};
+      const nlohmann::json request = {
+          {"method", to_string(method)},
+          {"camera", nlohmann::json(camera_json(bench::peer_camera(scene)))},
+          {"w", size.width},
+          {"h", size.height}};
       bench::add(
           ("web/peer/webgl/" + std::string(view.name) + "/" + to_string(method) + "/" + at).c_str(),
           bench::ours, &web, page, request, std::string(view.name))

@@ -73,10 +73,12 @@ void draw_gallery(json& results, const std::vector<std::string>& galleries,
 // regression section (and the gate), and the page.
 void merge_report_shards(const Files& files, const fs::path& out, const std::string& baseline,
                          const std::vector<std::string>& galleries, bool html,
-                         const std::string& python) {
+                         const std::string& python, bool one_machine) {
   json results = reports::merge_report(files);
   const fs::path images = folder_of(out) / "images";
-  gather_images(files, images);
+  // A machine's page shows its images; machines compared, none (nor could one folder hold each
+  // machine's frames of the same case).
+  if (one_machine) gather_images(files, images);
   if (html) draw_gallery(results, galleries, images);
   results["regression"] = regression_section(results, baseline);
   write_json(out, results);
@@ -164,7 +166,7 @@ void add_merge(CLI::App& app) {
         }
         if (machines.size() == 1) {
           merge_report_shards(machines.front(), out, o->baseline, o->galleries, !o->no_html,
-                              o->python);
+                              o->python, true);
           return;
         }
         if (!o->baseline.empty())
@@ -181,7 +183,7 @@ void add_merge(CLI::App& app) {
                ++k)
             file = folder_of(out) / (out.stem().string() + "-" + file_word(host) + "-" +
                                      std::to_string(k) + ".json");
-          merge_report_shards(machine, file, "", o->galleries, false, o->python);
+          merge_report_shards(machine, file, "", o->galleries, false, o->python, false);
           merged.push_back(file.string());
         }
         if (!o->no_html) {

@@ -646,7 +646,8 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
       out["matrix"]["cases"].push_back(matrix[key.get<std::string>()]);
   if (!sweep_options.is_null())
     out["sweep"] = merged_sweep(sweep_options, std::move(points), std::move(confirmations),
-                                first["options"]["scenes"], sweep_options["methods"]);
+                                first["options"]["scenes"],
+                                sweep_options.value("methods", first["registry"]["methods"]));
   if (first.contains("scaling")) {
     const auto key = [&](const json& s) {
       return position.at("scaling/" + s["family"].get<std::string>() + "/" +

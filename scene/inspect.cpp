@@ -134,13 +134,16 @@ nlohmann::ordered_json inspect(const Scene& scene) {
                        {"radius", scene.markers[m].radius}});
   out["objects"] = std::move(objects);
   out["markers"] = std::move(markers);
-  const Camera& c = scene.camera;
-  out["camera"] = {{"polygon", c.polygon},
-                   {"position", point(c.position)},
-                   {"yaw_deg", c.yaw_deg},
-                   {"pitch_deg", c.pitch_deg},
-                   {"fov_deg", c.fov_deg}};
+  out["camera"] = camera_json(scene.camera);
   return out;
+}
+
+nlohmann::ordered_json camera_json(const Camera& c) {
+  return {{"polygon", c.polygon},
+          {"position", point(c.position)},
+          {"yaw_deg", c.yaw_deg},
+          {"pitch_deg", c.pitch_deg},
+          {"fov_deg", c.fov_deg}};
 }
 
 }  // namespace flatmarch

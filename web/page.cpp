@@ -8,6 +8,7 @@
 
 #include "kernels/compile.hpp"
 #include "kernels/scene_shader.hpp"
+#include "scene/inspect.hpp"
 #include "viewer/controls.hpp"
 #include "viewer/walk.hpp"
 
@@ -85,15 +86,9 @@ std::string page(const Scene& scene, const MarchParams& params, const PageOption
     p.method = m;
     shaders[to_string(m)] = kernel::web_fragment_shader(kernel::compile_scene<float>(scene, p));
   }
-  const Camera& c = scene.camera;
   json data = {{"name", scene.name},
                {"description", scene.description},
-               {"camera",
-                {{"polygon", c.polygon},
-                 {"position", {c.position.x, c.position.y, c.position.z}},
-                 {"yaw_deg", c.yaw_deg},
-                 {"pitch_deg", c.pitch_deg},
-                 {"fov_deg", c.fov_deg}}},
+               {"camera", json(camera_json(scene.camera))},
                {"method", to_string(params.method)},
                {"eps", params.eps},
                {"offset", params.offset},
