@@ -5,6 +5,7 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -69,7 +70,7 @@ inline bool parse_size(const std::string& text, int& width, int& height) {
 struct Run {
   std::optional<reports::Shard> shard;
   std::vector<std::string> names;
-  std::vector<double> costs;  // of each name: expected seconds, or 1 where none was given
+  std::vector<double> costs;  // of each name: expected seconds, NaN where none was given
   std::string flags;
   bool writes_json = false;  // --benchmark_out given
 };
@@ -82,16 +83,17 @@ inline Run& run_state() {
 template <class... Args>
 benchmark::internal::Benchmark* add(const std::string& name, Args&&... args) {
   run_state().names.push_back(name);
-  run_state().costs.push_back(1.0);
+  run_state().costs.push_back(std::nan(""));
   return benchmark::RegisterBenchmark(name.c_str(), std::forward<Args>(args)...);
 }
 // Records the name of a benchmark registered otherwise (reports::register_frame_benchmark).
 inline void note(const std::string& name) {
   run_state().names.push_back(name);
-  run_state().costs.push_back(1.0);
+  run_state().costs.push_back(std::nan(""));
 }
 // The expected cost of the benchmark registered last (reports::frame_cost of its frame), by
-// which --shard balances the shards; without it every benchmark costs alike.
+// which --shard balances the shards; one without costs the median of those with (all alike
+// where none has one).
 inline void cost(double seconds) {
   if (!run_state().costs.empty()) run_state().costs.back() = seconds;
 }
@@ -127,10 +129,10 @@ inline std::string regex_escaped(const std::string& name) {
 }
 
 // Runs the registered benchmarks, or with --shard=I/N those of shard I: of the names that
-// --benchmark_filter selects, in the order registered, split by their cost (cost(); alike where
-// none was given), the same split in every shard. The JSON
-// context then carries the machine's fingerprint and "flatmarch_shard" (the shard's record:
-// reports::shard_record) and "flatmarch_flags", for `flatmarch merge`. Returns the exit status.
+// --benchmark_filter selects, in the order registered, split by their cost (cost()), the same
+// split in every shard. The JSON context then carries the machine's fingerprint and
+// "flatmarch_shard" (the shard's record: reports::shard_record) and "flatmarch_flags", for
+// `flatmarch merge`. Returns the exit status.
 inline int run() {
   Run& r = run_state();
   if (!r.shard) {
@@ -142,15 +144,12 @@ inline int run() {
   const bool negative = !filter.empty() && filter[0] == '-';
   if (negative) filter.erase(0, 1);
   const bool all = filter.empty() || filter == "." || filter == "all";
-  std::vector<std::string> cases;
-  std::vector<double> costs;
+  std::vector<std::pair<std::string, double>> cases;
   try {
     const std::regex selects(all ? "." : filter);
     for (size_t k = 0; k < r.names.size(); ++k)
-      if (all || std::regex_search(r.names[k], selects) != negative) {
-        cases.push_back(r.names[k]);
-        costs.push_back(r.costs[k]);
-      }
+      if (all || std::regex_search(r.names[k], selects) != negative)
+        cases.emplace_back(r.names[k], r.costs[k]);
   } catch (const std::regex_error& e) {
     std::fprintf(stderr, "--benchmark_filter: not a regular expression: %s\n", e.what());
     return 2;
@@ -160,8 +159,13 @@ inline int run() {
                  r.shard->text().c_str(), cases.size());
     return 2;
   }
-  const std::vector<int> assignment = reports::assign_shards(costs, r.shard->count);
-  const nlohmann::json record = reports::shard_record(*r.shard, cases, assignment, costs);
+  std::vector<double> given;
+  for (const auto& c : cases)
+    if (!std::isnan(c.second)) given.push_back(c.second);
+  std::sort(given.begin(), given.end());
+  for (auto& c : cases)
+    if (std::isnan(c.second)) c.second = given.empty() ? 1.0 : given[given.size() / 2];
+  const nlohmann::json record = reports::plan_shard(*r.shard, cases, "benchmarks").record;
   std::string spec;
   for (const auto& name : record["holds"])
     spec += (spec.empty() ? "" : "|") + regex_escaped(name.get<std::string>());

@@ -133,8 +133,7 @@ void add_conform(CLI::App& app) {
       suite.keep_pixel_classes(true);
     }
     std::optional<reports::Shard> shard;
-    if (!o->shard.empty() && !(shard = reports::parse_shard(o->shard)))
-      throw UsageError("--shard: I/N with 1 <= I <= N <= 1000, not " + o->shard);
+    if (!o->shard.empty()) shard = parse_shard_option(o->shard);
     nlohmann::json out = {{"format", "flatmarch-conform/1"},
                           {"fingerprint", reports::hardware_fingerprint()},
                           {"options",
@@ -166,35 +165,27 @@ void add_conform(CLI::App& app) {
       }
       backends.push_back(std::move(backend));
     }
-    std::vector<std::string> names;
-    std::vector<double> costs;
+    std::vector<std::pair<std::string, double>> run;
     for (const auto& backend : backends)
       for (const Scene& scene : scenes)
-        for (const Method m : methods) {
-          names.push_back(backend->name() + "/" + to_string(m) + "/" + scene.name);
-          costs.push_back(reports::conformance_case_cost(backend->name(), to_string(m),
-                                                         reports::edge_count(scene), w, h));
-        }
-    const std::vector<int> assignment = reports::assign_shards(costs, shard ? shard->count : 1);
+        for (const Method m : methods)
+          run.emplace_back(backend->name() + "/" + to_string(m) + "/" + scene.name,
+                           reports::conformance_case_cost(backend->name(), to_string(m),
+                                                          reports::edge_count(scene), w, h));
+    const reports::ShardPlan plan = reports::plan_shard(shard.value_or(reports::Shard{}), run);
     if (shard) {
-      out["shard"] = reports::shard_record(*shard, names, assignment, costs);
-      const auto& held = out["shard"]["holds"];
-      const double cost = out["shard"]["costs"][static_cast<size_t>(shard->index - 1)];
-      std::fprintf(stderr,
-                   "conform: shard %s holds %zu of the run's %zu cases, about %.0f s here by "
-                   "their expected cost\n",
-                   shard->text().c_str(), held.size(), names.size(), cost);
+      out["shard"] = plan.record;
+      std::fprintf(stderr, "conform: %s\n", plan.summary.c_str());
     }
     if (!o->quiet)
       std::printf("%-8s %-30s %-9s %7s %8s %8s %7s %7s %6s  %-24s %s\n", "backend", "scene",
                   "method", "ambig%", "hit%", "cross%", "img%", "stepKS", "traces", "failures",
                   "verdict");
-    size_t next = 0;
     for (const auto& backend : backends) {
       const std::string name = backend->name();
       for (const Scene& scene : scenes)
         for (const Method m : methods) {
-          if (assignment[next++] != (shard ? shard->index : 1)) continue;
+          if (!plan.holds(name + "/" + to_string(m) + "/" + scene.name)) continue;
           MarchParams params = o->params;
           params.method = m;
           const conformance::CaseResult r = suite.run(*backend, scene, params, w, h);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
-#include <set>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
@@ -84,23 +83,12 @@ void add_sweep(CLI::App& app) {
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
     json shard;
     if (!o->shard.empty()) {
-      const reports::Shard s = parse_shard_option(o->shard);
-      std::vector<std::string> names;
-      std::vector<double> costs;
-      for (const auto& [name, cost] : reports::sweep_cases(scenes, o->sweep)) {
-        names.push_back(name);
-        costs.push_back(cost);
-      }
-      shard = reports::shard_record(s, names, reports::assign_shards(costs, s.count), costs);
-      const auto held =
-          std::make_shared<std::set<std::string>>(shard["holds"].begin(), shard["holds"].end());
-      o->sweep.holds = [held](const std::string& key) { return held->count(key) > 0; };
+      reports::ShardPlan plan = reports::plan_shard(
+          parse_shard_option(o->shard), reports::sweep_cases(scenes, o->sweep), "groups");
+      shard = std::move(plan.record);
+      o->sweep.holds = plan.holds;
       // Said even when quiet: the first line of a scheduler's log.
-      std::fprintf(stderr,
-                   "sweep: shard %s holds %zu of the run's %zu groups, about %.0f s here by "
-                   "their expected costs\n",
-                   s.text().c_str(), held->size(), names.size(),
-                   shard["costs"][static_cast<size_t>(s.index - 1)].get<double>());
+      std::fprintf(stderr, "sweep: %s\n", plan.summary.c_str());
     }
     conformance::Suite suite;
     ProgressReporter progress("sweep", o->quiet);

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <ctime>
 #include <map>
-#include <memory>
 #include <set>
 
 #include "reports/fingerprint.hpp"
@@ -62,31 +61,10 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
   ReportOptions o = options;
   json shard;
   if (o.shard) {
-    std::vector<std::string> names;
-    std::vector<double> costs;
-    for (const auto& [name, cost] : report_cases(scenes, o)) {
-      names.push_back(name);
-      costs.push_back(cost);
-    }
-    const std::vector<int> assignment = assign_shards(costs, o.shard->count);
-    shard = shard_record(*o.shard, names, assignment, costs);
-    const auto held =
-        std::make_shared<std::set<std::string>>(shard["holds"].begin(), shard["holds"].end());
-    const auto holds = [held](const std::string& key) { return held->count(key) > 0; };
-    o.matrix.holds = o.sweep.holds = o.scaling.holds = holds;
-    if (progress) {
-      const auto seconds = [](double s) {
-        char text[32];
-        std::snprintf(text, sizeof text, s < 10.0 ? "%.1f" : "%.0f", s);
-        return std::string(text);
-      };
-      std::string line = "shard " + o.shard->text() + " holds " + std::to_string(held->size()) +
-                         " of the run's " + std::to_string(names.size()) + " cases, about " +
-                         seconds(shard["costs"][static_cast<size_t>(o.shard->index - 1)]) +
-                         " s here by their expected costs (each shard's:";
-      for (const json& c : shard["costs"]) line += " " + seconds(c.get<double>());
-      progress("shard", line + " s)", 0, 0);
-    }
+    ShardPlan plan = plan_shard(*o.shard, report_cases(scenes, o));
+    shard = std::move(plan.record);
+    o.matrix.holds = o.sweep.holds = o.scaling.holds = plan.holds;
+    if (progress) progress("shard", plan.summary, 0, 0);
   }
   json results = {{"format", "flatmarch-report/1"}, {"created", now_utc()}};
   results["fingerprint"] = hardware_fingerprint();

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <numeric>
+#include <set>
 #include <stdexcept>
 
 namespace flatmarch::reports {
@@ -83,6 +85,33 @@ json shard_record(const Shard& shard, const std::vector<std::string>& cases,
           {"cases", cases},
           {"holds", holds},
           {"costs", load}};
+}
+
+ShardPlan plan_shard(const Shard& shard, const std::vector<std::pair<std::string, double>>& cases,
+                     const std::string& noun) {
+  std::vector<std::string> names;
+  std::vector<double> costs;
+  for (const auto& [name, cost] : cases) {
+    names.push_back(name);
+    costs.push_back(cost);
+  }
+  ShardPlan plan;
+  plan.record = shard_record(shard, names, assign_shards(costs, shard.count), costs);
+  const auto held = std::make_shared<std::set<std::string>>(plan.record["holds"].begin(),
+                                                            plan.record["holds"].end());
+  plan.holds = [held](const std::string& name) { return held->count(name) > 0; };
+  const auto seconds = [](double s) {
+    char text[32];
+    std::snprintf(text, sizeof text, s < 10.0 ? "%.1f" : "%.0f", s);
+    return std::string(text);
+  };
+  plan.summary = "shard " + shard.text() + " holds " + std::to_string(held->size()) +
+                 " of the run's " + std::to_string(names.size()) + " " + noun + ", about " +
+                 seconds(plan.record["costs"][static_cast<size_t>(shard.index - 1)]) +
+                 " s here by their expected costs (each shard's:";
+  for (const json& c : plan.record["costs"]) plan.summary += " " + seconds(c.get<double>());
+  plan.summary += " s)";
+  return plan;
 }
 
 namespace {

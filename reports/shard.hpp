@@ -4,6 +4,7 @@
 // balancing them (longest first, each to the least loaded shard).
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +65,19 @@ nlohmann::json machine_of(const nlohmann::json& results);
 // What every merged result begins with: the first shard's format, fingerprint and options, and
 // "merged_from" (the files) and "hosts" (where the shards ran).
 nlohmann::json merged_header(const std::vector<std::pair<std::string, nlohmann::json>>& files);
+
+// A shard's part of a run: its shard_record, whether it holds a case (by name), and the line it
+// says before it starts ("shard 1/4 holds 86 of the run's 348 cases, about 81 s here by their
+// expected costs (each shard's: 81 81 81 81 s)", `noun` naming the cases).
+struct ShardPlan {
+  nlohmann::json record;
+  std::function<bool(const std::string& name)> holds;
+  std::string summary;
+};
+// The plan of `shard` over a run's cases (names in the run's order, each with its expected
+// seconds), split by assign_shards.
+ShardPlan plan_shard(const Shard& shard, const std::vector<std::pair<std::string, double>>& cases,
+                     const std::string& noun = "cases");
 
 // Merges the results of a sharded `flatmarch conform` (each file's JSON, with its name for
 // errors): checks that they are the shards 1..N of one run (same format, flatmarch build,
