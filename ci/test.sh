@@ -72,6 +72,8 @@ stage "build (fuzzers, clang)" env CC=clang CXX=clang++ ci/build.sh build-fuzz -
 echo
 echo "==== summary"
 printf '%s\n' "${summaries[@]}"
+# CI machines have little disk (a sanitizer build that linked every test whole filled one).
+echo "disk: $(du -sh build build-asan build-fuzz 2>/dev/null | awk '{printf "%s %s  ", $2, $1}')"
 if ((failed)); then
   printf '%s\n' "${ctest_summary[@]}"
   echo "test.sh: FAILED (see the stages above)"
