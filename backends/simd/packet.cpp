@@ -66,12 +66,9 @@ int PacketLanes() {
 }
 
 // maths.glsl's camera_ray for each lane's pixel (i, j): through the pixel's centre.
-HWY_INLINE void CameraRays(const PacketJob& job, const int32_t* i, const int32_t* j, V& dx, V& dy,
-                           V& dz) {
-  const DI di;
+HWY_INLINE void CameraRays(const PacketJob& job, VI i, VI j, V& dx, V& dy, V& dz) {
   const CameraBasis<float>& c = job.basis;
-  const lane::vec2 at(hn::ConvertTo(D(), hn::LoadU(di, i)) + Splat(0.5f),
-                      hn::ConvertTo(D(), hn::LoadU(di, j)) + Splat(0.5f));
+  const lane::vec2 at(hn::ConvertTo(D(), i) + Splat(0.5f), hn::ConvertTo(D(), j) + Splat(0.5f));
   const lane::vec2 size(static_cast<float>(job.width), static_cast<float>(job.height));
   const lane::vec3 d = lane::camera_ray(lane::Broadcast(c.forward), lane::Broadcast(c.right),
                                         lane::Broadcast(c.up), c.tan_half_fov, c.aspect, at, size);
@@ -166,9 +163,13 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   constexpr size_t kMax = hn::MaxLanes(DI());
   const size_t n = hn::Lanes(D());
   std::array<float, kMax> red{}, green{}, blue{}, t{}, steps{}, crossings{}, hit{};
-  std::array<int32_t, kMax> fresh{};
   std::array<int32_t, kMax> pixel_i{}, pixel_j{};
   pixel_i.fill(-1);  // -1: the lane holds no pixel
+  // The same pixels in vectors, kept beside the arrays lane by lane rather than loaded from them:
+  // a vector load of lanes just stored one by one cannot be forwarded from the stores, and waits
+  // until they (and the frame's writes before them) have reached the cache.
+  VI lane_i = SplatI(-1), lane_j = SplatI(-1);
+  const VI lane_index = hn::Iota(di, 0);
   const V from_x = Splat(job.from.x), from_y = Splat(job.from.y), from_z = Splat(job.from.z);
   Frame& frame = *job.frame;
 
@@ -194,7 +195,6 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
     // Lanes are refilled once enough of them wait, or when none is left marching.
     const M waiting = !queue.empty() ? r.done : hn::And(r.done, occupied);
     const size_t count = hn::CountTrue(D(), waiting);
-    bool refill = false;
     if (count > 0 && (count >= (spread ? kRefillSpread : kRefillAt) * n / 8 ||
                       hn::AllTrue(D(), r.done) || (patience > 0 && waited >= patience))) {
       waited = 0;
@@ -208,7 +208,8 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       hn::StoreU(hn::ConvertTo(D(), r.steps), D(), steps.data());
       hn::StoreU(hn::ConvertTo(D(), r.crossings), D(), crossings.data());
       hn::StoreU(hn::ConvertTo(D(), r.hit), D(), hit.data());
-      fresh.fill(0);
+      M fresh = None();
+      bool refill = false;
       uint8_t bits[8] = {};
       hn::StoreMaskBits(D(), waiting, bits);
       uint64_t lanes_waiting = 0;
@@ -218,21 +219,24 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
         if (pixel_i[l] >= 0)
           frame.set(frame.pixel(pixel_i[l], pixel_j[l]), red[l], green[l], blue[l], steps[l],
                     crossings[l], hit[l], t[l]);
+        const auto here = hn::Eq(lane_index, hn::Set(di, static_cast<int32_t>(l)));
         if (queue.pop(pixel_i[l], pixel_j[l])) {
-          fresh[l] = -1;
+          fresh = hn::Or(fresh, hn::RebindMask(D(), here));
+          lane_i = hn::IfThenElse(here, hn::Set(di, pixel_i[l]), lane_i);
+          lane_j = hn::IfThenElse(here, hn::Set(di, pixel_j[l]), lane_j);
           refill = true;
         } else {
           pixel_i[l] = -1;
+          lane_i = hn::IfThenElse(here, SplatI(-1), lane_i);
         }
       }
-      occupied = hn::RebindMask(D(), hn::Gt(hn::LoadU(di, pixel_i.data()), SplatI(-1)));
-    }
-    if (refill) {
-      const M m = hn::RebindMask(D(), hn::MaskFromVec(hn::LoadU(di, fresh.data())));
-      V dx, dy, dz;
-      CameraRays(job, pixel_i.data(), pixel_j.data(), dx, dy, dz);
-      marcher.start(r, x, seg, m, job.polygon, from_x, from_y, from_z, dx, dy, dz);
-      continue;  // a ray may end as it starts (a miss): write it out before stepping
+      occupied = hn::RebindMask(D(), hn::Gt(lane_i, SplatI(-1)));
+      if (refill) {
+        V dx, dy, dz;
+        CameraRays(job, lane_i, lane_j, dx, dy, dz);
+        marcher.start(r, x, seg, fresh, job.polygon, from_x, from_y, from_z, dx, dy, dz);
+        continue;  // a ray may end as it starts (a miss): write it out before stepping
+      }
     }
     if (hn::AllTrue(D(), r.done)) break;  // no pixels left and every ray written
     const int rooms = marcher.step(r, x, seg, *lanes);
@@ -255,7 +259,8 @@ void CentralPacket(const PacketJob& job, const Marcher& marcher, Packet& r, Rela
     pixel_j[l] = std::clamp(j, 0, job.height - 1);
   }
   V dx, dy, dz;
-  CameraRays(job, pixel_i.data(), pixel_j.data(), dx, dy, dz);
+  const DI di;
+  CameraRays(job, hn::LoadU(di, pixel_i.data()), hn::LoadU(di, pixel_j.data()), dx, dy, dz);
   Marcher::clear(r, x, seg);
   marcher.start(r, x, seg, hn::Not(None()), job.polygon, Splat(job.from.x), Splat(job.from.y),
                 Splat(job.from.z), dx, dy, dz);
