@@ -1,9 +1,10 @@
 // `flatmarch merge`: the shards of a run, each run apart (`--shard I/N`, on a Slurm job array or
 // a CI matrix), put back together (reports/shard.hpp).
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -92,6 +93,50 @@ void merge_report_shards(const Files& files, const fs::path& out, const std::str
   if (!baseline.empty()) gate(results, baseline, folder_of(out));
 }
 
+// Shards of `flatmarch report`: one machine's merged into `out`; several kinds of machine's each
+// into OUT-MACHINE.json (no gate: it judges one machine) and a page comparing them.
+void merge_reports(Files docs, const fs::path& out, const std::string& baseline,
+                   const std::vector<std::string>& galleries, bool html,
+                   const std::string& python) {
+  std::vector<Files> machines;  // the shards by machine, in the order first given
+  std::vector<json> kinds;
+  for (auto& doc : docs) {
+    const json kind = reports::machine_of(doc.second);
+    const size_t k =
+        static_cast<size_t>(std::find(kinds.begin(), kinds.end(), kind) - kinds.begin());
+    if (k == kinds.size()) {
+      kinds.push_back(kind);
+      machines.emplace_back();
+    }
+    machines[k].push_back(std::move(doc));
+  }
+  if (machines.size() == 1) {
+    merge_report_shards(machines.front(), out, baseline, galleries, html, python, true);
+    return;
+  }
+  if (!baseline.empty())
+    throw UsageError("--baseline gates one machine's results: these shards come from " +
+                     std::to_string(machines.size()) + " kinds of machine");
+  std::vector<std::string> merged;
+  for (const Files& machine : machines) {
+    const json& fingerprint = machine.front().second["fingerprint"];
+    const std::string host = fingerprint.value("host", "");
+    const std::string word = file_word(
+        host.empty() ? fingerprint.value(json::json_pointer("/cpu/model"), std::string()) : host);
+    fs::path file = folder_of(out) / (out.stem().string() + "-" + word + ".json");
+    for (int k = 2; std::find(merged.begin(), merged.end(), file.string()) != merged.end(); ++k)
+      file =
+          folder_of(out) / (out.stem().string() + "-" + word + "-" + std::to_string(k) + ".json");
+    merge_report_shards(machine, file, "", galleries, false, python, false);
+    merged.push_back(file.string());
+  }
+  if (html) {
+    make_report_page(python, merged, folder_of(out), "");
+    std::printf("merge: %zu machines compared: open %s\n", merged.size(),
+                (folder_of(out) / "index.html").c_str());
+  }
+}
+
 }  // namespace
 
 void add_merge(CLI::App& app) {
@@ -151,46 +196,7 @@ void add_merge(CLI::App& app) {
     const fs::path out(o->out);
     try {
       if (format == "flatmarch-report/1") {
-        // The shards by machine, in the order first given.
-        std::vector<Files> machines;
-        std::vector<json> kinds;
-        for (auto& doc : docs) {
-          const json kind = reports::machine_of(doc.second);
-          size_t k = 0;
-          while (k < kinds.size() && kinds[k] != kind) ++k;
-          if (k == kinds.size()) {
-            kinds.push_back(kind);
-            machines.emplace_back();
-          }
-          machines[k].push_back(std::move(doc));
-        }
-        if (machines.size() == 1) {
-          merge_report_shards(machines.front(), out, o->baseline, o->galleries, !o->no_html,
-                              o->python, true);
-          return;
-        }
-        if (!o->baseline.empty())
-          throw UsageError("--baseline gates one machine's results: these shards come from " +
-                           std::to_string(machines.size()) + " kinds of machine");
-        std::vector<std::string> merged;
-        for (const Files& machine : machines) {
-          const std::string host = machine.front().second["fingerprint"].value("host", "");
-          const std::string cpu = machine.front().second["fingerprint"].value(
-              json::json_pointer("/cpu/model"), std::string());
-          fs::path file = folder_of(out) / (out.stem().string() + "-" +
-                                            file_word(host.empty() ? cpu : host) + ".json");
-          for (int k = 2; std::find(merged.begin(), merged.end(), file.string()) != merged.end();
-               ++k)
-            file = folder_of(out) / (out.stem().string() + "-" + file_word(host) + "-" +
-                                     std::to_string(k) + ".json");
-          merge_report_shards(machine, file, "", o->galleries, false, o->python, false);
-          merged.push_back(file.string());
-        }
-        if (!o->no_html) {
-          make_report_page(o->python, merged, folder_of(out), "");
-          std::printf("merge: %zu machines compared: open %s\n", merged.size(),
-                      (folder_of(out) / "index.html").c_str());
-        }
+        merge_reports(std::move(docs), out, o->baseline, o->galleries, !o->no_html, o->python);
         return;
       }
       if (!o->baseline.empty() || o->no_html)

@@ -220,8 +220,9 @@ std::map<std::string, Timing> timings(const json& document) {
   return result;
 }
 
-std::string matrix_case_key(const std::string& backend, Method method, const std::string& scene) {
-  return "matrix/" + backend + "/" + to_string(method) + "/" + scene;
+std::string matrix_case_key(const std::string& backend, const std::string& method,
+                            const std::string& scene) {
+  return "matrix/" + backend + "/" + method + "/" + scene;
 }
 
 namespace {
@@ -262,7 +263,7 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
         if (o.timing)
           cost += timed_case_cost(frame_cost(backend->name(), method, o.width, o.height),
                                   o.repetitions, o.min_time);
-        cases.emplace_back(matrix_case_key(backend->name(), m, scene.name), cost);
+        cases.emplace_back(matrix_case_key(backend->name(), to_string(m), scene.name), cost);
       }
   return cases;
 }
@@ -277,7 +278,7 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
           skip["backend"].get<std::string>() + " skipped: " + skip["reason"].get<std::string>(), 0,
           0);
   const auto held = [&](const Backend& backend, Method m, const Scene& scene) {
-    return !o.holds || o.holds(matrix_case_key(backend.name(), m, scene.name));
+    return !o.holds || o.holds(matrix_case_key(backend.name(), to_string(m), scene.name));
   };
   int total = 0;
   for (const auto& backend : backends)

@@ -37,7 +37,8 @@ struct MatrixOptions {
 };
 
 // A matrix case's key in a sharded run's case list: "matrix/BACKEND/METHOD/SCENE".
-std::string matrix_case_key(const std::string& backend, Method method, const std::string& scene);
+std::string matrix_case_key(const std::string& backend, const std::string& method,
+                            const std::string& scene);
 
 // The matrix's cases (backends available here x scenes x methods, in run_matrix's order) by key,
 // each with its expected seconds on this machine (conformance and timing).

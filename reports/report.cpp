@@ -540,10 +540,6 @@ std::string describe_gate(const json& check, const json& baseline,
   return out;
 }
 
-}  // namespace flatmarch::reports
-
-namespace flatmarch::reports {
-
 json merge_report(const std::vector<std::pair<std::string, json>>& files) {
   const std::vector<const std::pair<std::string, json>*> shards =
       check_shards(files, "flatmarch-report/1", "flatmarch report");
@@ -553,22 +549,15 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
   for (size_t k = 0; k < list.size(); ++k) position[list[k].get<std::string>()] = k;
 
   std::map<std::string, json> matrix;  // case key -> case
-  std::set<std::string> found;         // keys of the cases the shards hold results of
   json benchmarks = json::array(), context = json::object(), scaling_benchmarks = json::array();
   json points = json::array(), confirmations = json::array(), series = json::array();
   json sweep_options, seconds = json::object(), per_shard = json::array();
   for (const auto* entry : shards) {
     const auto& [file, doc] = *entry;
-    const json& holds = doc["shard"]["holds"];
-    const auto check_held = [&](const std::string& key) {
-      if (std::find(holds.begin(), holds.end(), key) == holds.end())
-        throw std::invalid_argument(file + ": holds " + key + ", which is not its shard's");
-      found.insert(key);
-    };
+    ShardContents contents(file, doc["shard"]);
     for (const json& c : doc.at("matrix").at("cases")) {
-      const std::string key = "matrix/" + c["backend"].get<std::string>() + "/" +
-                              c["method"].get<std::string>() + "/" + c["scene"].get<std::string>();
-      check_held(key);
+      const std::string key = matrix_case_key(c["backend"], c["method"], c["scene"]);
+      contents.add(key);
       matrix[key] = c;
     }
     const json& timed = doc["matrix"].value("benchmarks", json::object());
@@ -580,16 +569,14 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
         throw std::invalid_argument(file + ": its sweep's options differ from " +
                                     shards.front()->first + "'s: not a shard of the same run");
       for (const json& p : doc["sweep"]["points"]) {
-        check_held("sweep/" + p["surface_type"].get<std::string>() + "/" +
-                   p["method"].get<std::string>());
+        contents.add(sweep_case_key(p["surface_type"], p["method"]));
         points.push_back(p);
       }
       for (const json& k : doc["sweep"]["confirmations"]) confirmations.push_back(k);
     }
     if (doc.contains("scaling")) {
       for (const json& s : doc["scaling"]["series"]) {
-        check_held("scaling/" + s["family"].get<std::string>() + "/" +
-                   s["backend"].get<std::string>() + "/" + s["method"].get<std::string>());
+        contents.add(scaling_case_key(s["family"], s["backend"], s["method"]));
         series.push_back(s);
       }
       const json& runs = doc["scaling"].value("benchmarks", json::object());
@@ -604,12 +591,8 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
          {"host", doc["fingerprint"].value("host", json(""))},
          {"seconds", doc.value("seconds", json::object())},
          {"expected_seconds", doc["shard"]["costs"][doc["shard"]["index"].get<size_t>() - 1]}});
+    contents.complete();
   }
-  for (const auto* entry : shards)
-    for (const json& key : entry->second["shard"]["holds"])
-      if (!found.count(key.get<std::string>()))
-        throw std::invalid_argument(entry->first + ": has no results of " + key.get<std::string>() +
-                                    ", which its shard holds (an interrupted run?)");
 
   json out = merged_header(files);
   out["created"] = now_utc();
@@ -628,8 +611,7 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
                                 sweep_options.value("methods", first["registry"]["methods"]));
   if (first.contains("scaling")) {
     const auto key = [&](const json& s) {
-      return position.at("scaling/" + s["family"].get<std::string>() + "/" +
-                         s["backend"].get<std::string>() + "/" + s["method"].get<std::string>());
+      return position.at(scaling_case_key(s["family"], s["backend"], s["method"]));
     };
     std::stable_sort(series.begin(), series.end(),
                      [&](const json& a, const json& b) { return key(a) < key(b); });

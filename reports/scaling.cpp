@@ -44,8 +44,9 @@ struct Series {
 
 }  // namespace
 
-std::string scaling_case_key(const std::string& family, const std::string& backend, Method method) {
-  return "scaling/" + family + "/" + backend + "/" + to_string(method);
+std::string scaling_case_key(const std::string& family, const std::string& backend,
+                             const std::string& method) {
+  return "scaling/" + family + "/" + backend + "/" + method;
 }
 
 namespace {
@@ -121,7 +122,7 @@ std::vector<std::pair<std::string, double>> scaling_cases(const ScalingOptions& 
                                std::max(1.0, p.max_distance / 20.0);
           cost += timed_case_cost(frame, o.repetitions, o.min_time);
         }
-        cases.emplace_back(scaling_case_key(s.family, b->name(), m), cost);
+        cases.emplace_back(scaling_case_key(s.family, b->name(), to_string(m)), cost);
       }
   return cases;
 }
@@ -133,7 +134,7 @@ json run_scaling(const ScalingOptions& o,
   json out = {{"series", json::array()}, {"skipped", json::array()}};
   const std::vector<std::unique_ptr<Backend>> backends = scaling_backends(o, &out["skipped"]);
   const auto held = [&](const Series& s, const Backend& b, Method m) {
-    return !o.holds || o.holds(scaling_case_key(s.family, b.name(), m));
+    return !o.holds || o.holds(scaling_case_key(s.family, b.name(), to_string(m)));
   };
   const auto name_of = [](const Series& s, const Backend& b, Method m, const Point& p) {
     return "scaling/" + s.axis + "/" + p.scene->name + "/" + b.name() + "/" + to_string(m) + "/" +

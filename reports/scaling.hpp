@@ -35,7 +35,8 @@ struct ScalingOptions {
 };
 
 // A series' key in a sharded run's case list: "scaling/FAMILY/BACKEND/METHOD".
-std::string scaling_case_key(const std::string& family, const std::string& backend, Method method);
+std::string scaling_case_key(const std::string& family, const std::string& backend,
+                             const std::string& method);
 
 // The series (families x backends available here x methods, in run_scaling's order) by key, each
 // with its expected seconds on this machine.

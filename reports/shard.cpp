@@ -129,6 +129,22 @@ void same(const std::string& file, const json& doc, const json& first,
 
 }  // namespace
 
+ShardContents::ShardContents(std::string file, const json& shard)
+    : file_(std::move(file)),
+      holds_(shard.at("holds").begin(), shard.at("holds").end()),
+      held_(holds_.begin(), holds_.end()) {}
+
+void ShardContents::add(const std::string& key) {
+  if (!held_.count(key)) bad(file_, "holds " + key + ", which is not its shard's");
+  found_.insert(key);
+}
+
+void ShardContents::complete() const {
+  for (const std::string& key : holds_)
+    if (!found_.count(key))
+      bad(file_, "has no results of " + key + ", which its shard holds (an interrupted run?)");
+}
+
 std::vector<const std::pair<std::string, json>*> check_shards(
     const std::vector<std::pair<std::string, json>>& files, const std::string& format,
     const std::string& command) {
@@ -199,17 +215,14 @@ json merge_conformance(const std::vector<std::pair<std::string, json>>& files) {
   check_shards(files, "flatmarch-conform/1", "flatmarch conform");
   std::map<std::string, json> cases;
   for (const auto& [file, doc] : files) {
-    const json& holds = doc["shard"]["holds"];
+    ShardContents contents(file, doc["shard"]);
     for (const json& c : doc["cases"]) {
       const std::string name = c["backend"].get<std::string>() + "/" +
                                c["method"].get<std::string>() + "/" + c["scene"].get<std::string>();
-      if (std::find(holds.begin(), holds.end(), name) == holds.end())
-        bad(file, "holds case " + name + ", which is not its shard's");
+      contents.add(name);
       cases[name] = c;
     }
-    if (doc["cases"].size() != holds.size())
-      bad(file, "holds " + std::to_string(doc["cases"].size()) + " cases where its shard has " +
-                    std::to_string(holds.size()) + " (an interrupted run?)");
+    contents.complete();
   }
   const json& first = files.front().second;
   json out = merged_header(files);
@@ -266,20 +279,14 @@ json merge_benchmarks(const std::vector<std::pair<std::string, json>>& files) {
   for (const auto* entry : shards) {
     const std::string& file = entry->first;
     const json& doc = files[static_cast<size_t>(entry - docs.data())].second;
-    const json& holds = entry->second["shard"]["holds"];
-    std::vector<bool> ran(list.size(), false);
+    ShardContents contents(file, entry->second["shard"]);
     for (const json& run : doc["benchmarks"]) {
-      const size_t k = position(run.value("run_name", run.value("name", "")));
-      if (k == list.size() || std::find(holds.begin(), holds.end(), list[k]) == holds.end())
-        bad(file,
-            "holds a run of " + run.value("name", std::string("?")) + ", which is not its shard's");
-      ran[k] = true;
+      const std::string name = run.value("run_name", run.value("name", "?"));
+      const size_t k = position(name);
+      contents.add(k == list.size() ? name : list[k].get<std::string>());
       runs.emplace_back(k, run);
     }
-    for (const json& name : holds)
-      if (!ran[position(name.get<std::string>())])
-        bad(file, "has no run of " + name.get<std::string>() +
-                      ", which its shard holds (an interrupted run?)");
+    contents.complete();
   }
   std::stable_sort(runs.begin(), runs.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });

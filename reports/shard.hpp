@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,21 @@ struct ShardPlan {
 // seconds), split by assign_shards.
 ShardPlan plan_shard(const Shard& shard, const std::vector<std::pair<std::string, double>>& cases,
                      const std::string& noun = "cases");
+
+// What one shard's results hold, checked against its shard record's "holds" as they are read:
+// add() throws for a case that is not its shard's, complete() for a case of its shard it holds
+// no results of (an interrupted run). Both throw std::invalid_argument naming the file.
+class ShardContents {
+ public:
+  ShardContents(std::string file, const nlohmann::json& shard);
+  void add(const std::string& key);
+  void complete() const;
+
+ private:
+  std::string file_;
+  std::vector<std::string> holds_;  // in the run's order, for the first one missing
+  std::set<std::string> held_, found_;
+};
 
 // Merges the results of a sharded `flatmarch conform` (each file's JSON, with its name for
 // errors): checks that they are the shards 1..N of one run (same format, flatmarch build,

@@ -37,7 +37,7 @@ struct SweepOptions {
 
 // A sweep group's key in a sharded run's case list: "sweep/SURFACE_TYPE/METHOD" (its every
 // precision and grid point on every scene of the type).
-std::string sweep_case_key(const std::string& surface_type, Method method);
+std::string sweep_case_key(const std::string& surface_type, const std::string& method);
 
 // The sweep's groups on `scenes` (surface types in the order they first appear x methods) by key,
 // each with its expected seconds on this machine (its grid on its scenes, and the re-checks).
