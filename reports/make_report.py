@@ -367,7 +367,10 @@ def ranking_section(results):
                         if stable else "; no method is stable there")
             rows.append((t, f'{p["eps"]:g}', f'{p["offset"]:g}',
                          f'<td class="{"limit" if p.get("fallback") else ""}">{src}</td>'))
-        parts.append(table(["surface type", "eps", "offset", "from"], rows))
+        opts = results.get("options", {})
+        parts.append(table(["surface type", "eps", "offset", "from"], rows) if rows else
+                     f'<p>No sweep in this run, so no eps and offset per surface type: every figure is at the '
+                     f'run\'s eps {opts.get("eps", 0):g} and offset {opts.get("offset", 0):g}.</p>')
     else:
         parts.append(f'<p class="bad">No recommendation: {esc(rec.get("why", ""))}</p>')
     methods = METHODS
