@@ -147,10 +147,28 @@ struct Rooms {
   std::array<M, kRoomsPerPass> lanes;  // the lanes in each
   M all;                               // the lanes of the pass
   VI first_edge, edge_count;           // of each lane's room, when there are several
+  // A pass over every unfinished lane whatever its room (Marcher::step's whole passes): `count`
+  // is 0, each lane's room is in `polygons` and its edges are held (HeldEdges).
+  bool whole = false;
+  VI polygons;
 };
 
 // The numbers of an edge the packet code reads, by name.
 enum Field { kAx, kAy, kAbx, kAby, kAyAby, kNx, kNy, kNa, kInvLength2, kTolerance, kFields };
+
+// Sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges each (the
+// cube, the staircases): each lane holds the numbers of its room's edges that a step reads
+// (kHeldFields), taken when a pass over several rooms first finds the lane in a room it does not
+// hold (Walls::hold), so that such a pass reads each lane's edges with a load instead of a
+// lookup or a broadcast per room blended by lane. A ray crosses once every 20-100 steps there,
+// so a lane's edges are taken far less often than they are read.
+constexpr int kHeldEdges = 4;
+constexpr std::array<Field, 6> kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
+struct HeldEdges {
+  VI polygon;                                             // the room each lane holds, -1: none
+  VI edge_count;                                          // its edges
+  std::array<std::array<V, kFields>, kHeldEdges> number;  // [edge][field], kHeldFields only
+};
 inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra) {
   switch (f) {
     case kAx:

@@ -49,9 +49,17 @@ class Marcher {
         params_(tables.params),
         features_(tables.features),
         events_(events),
-        max_events_(max_events) {}
+        max_events_(max_events),
+        whole_(walls_.held() && !has(kFeatureWalls) && solids_.by_lane()) {}
 
   // A packet with no rays: every lane done.
+  // Edges held by no lane.
+  static void clear(HeldEdges& held) {
+    held.polygon = SplatI(-1);
+    held.edge_count = SplatI(0);
+    for (auto& edge : held.number) edge.fill(Splat(0.0f));
+  }
+
   static void clear(Packet& r, Relaxation& x, Segment& seg) {
     r.polygon = r.steps = r.crossings = r.hit = SplatI(0);
     r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = r.t = Splat(0.0f);
@@ -100,7 +108,7 @@ class Marcher {
   // of the rays that have taken max_steps. A step runs in passes of up to kRoomsPerPass rooms
   // (usually one pass); the rays a pass moves to another room are already out of `pending`.
   // Returns the rooms its passes went over, summed.
-  FLATMARCH_PACKET_INLINE int step(Packet& r, Relaxation& x, Segment& seg,
+  FLATMARCH_PACKET_INLINE int step(Packet& r, Relaxation& x, Segment& seg, HeldEdges& held,
                                    LaneCounts& lanes) const {
     int rooms_seen = 0;
     const M active = hn::Not(r.done);
@@ -109,6 +117,26 @@ class Marcher {
     hn::StoreU(r.polygon, DI(), lane_rooms.data());
     M pending = active;
     const bool analytic = params_.method == kMethodAnalytic;
+    if (whole_ && Any(pending)) {
+      // Rays over several rooms take one pass, reading the edges they hold; rays in one room
+      // take the one-room pass below.
+      const int first = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
+      if (!hn::AllFalse(D(), hn::AndNot(Equal(r.polygon, first), pending))) {
+        walls_.hold(held, r.polygon, pending);
+        Rooms rooms;
+        rooms.whole = true;
+        rooms.all = pending;
+        rooms.polygons = r.polygon;
+        rooms.most_edges = kHeldEdges;
+        rooms.first_edge = SplatI(0);
+        rooms.edge_count = held.edge_count;
+        lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pending));
+        lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
+        sphere_step<false>(r, x, pending, rooms, &held);
+        pending = None();
+        rooms_seen = 2;  // several
+      }
+    }
     while (Any(pending)) {
       Rooms rooms;
       M pass = None();
@@ -129,14 +157,15 @@ class Marcher {
       rooms.all = pass;
       lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
       lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
-      if (rooms.count == 1 && analytic)
+      if (rooms.count == 1 && analytic) {
         analytic_step<true>(r, seg, pass, rooms);
-      else if (rooms.count == 1)
-        sphere_step<true>(r, x, pass, rooms);
-      else if (analytic)
+      } else if (rooms.count == 1) {
+        sphere_step<true>(r, x, pass, rooms, nullptr);
+      } else if (analytic) {
         analytic_step<false>(r, seg, pass, rooms);
-      else
-        sphere_step<false>(r, x, pass, rooms);
+      } else {
+        sphere_step<false>(r, x, pass, rooms, nullptr);
+      }
       pending = hn::AndNot(pass, pending);
       rooms_seen += rooms.count;
     }
@@ -280,10 +309,11 @@ class Marcher {
   }
 
   // One iteration of sphere or over-relaxed sphere tracing for the rays of `m`, in `rooms`.
+  // `held`: the edges the lanes hold, in a whole pass (else null).
   template <bool kOneRoom>
-  FLATMARCH_PACKET_INLINE void sphere_step(Packet& r, Relaxation& x, M m,
-                                           const Rooms& rooms) const {
-    const WallDistance wall = walls_.wall_distance<kOneRoom>(rooms, r.ox, r.oy);
+  FLATMARCH_PACKET_INLINE void sphere_step(Packet& r, Relaxation& x, M m, const Rooms& rooms,
+                                           const HeldEdges* held) const {
+    const WallDistance wall = walls_.wall_distance<kOneRoom>(rooms, held, r.ox, r.oy);
     const SolidDistance solid = solids_.nearest_solid(rooms, r.ox, r.oy, r.oz);
     const V radius = hn::Min(wall.d, solid.d);
     // Over-relaxed steps whose unbounding spheres do not overlap are taken back.
@@ -438,6 +468,9 @@ class Marcher {
   uint features_;
   std::vector<kernel::KernelEvent>* events_;
   int max_events_;
+  // Sphere and relaxed tracing where rooms have at most kHeldEdges edges, no wall and few
+  // solids: rays over several rooms take one pass a step, whatever their rooms.
+  bool whole_;
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)

@@ -178,7 +178,9 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   Packet r;
   Relaxation x;
   Segment seg;
+  HeldEdges held;
   Marcher::clear(r, x, seg);
+  Marcher::clear(held);
   // Every iteration steps at least one ray, and a ray takes at most max_steps steps.
   const int64_t bound = pixels * (int64_t{job.tables->params.max_steps} + 1) + 1;
   M occupied = None();  // lanes holding a pixel
@@ -239,7 +241,7 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
       }
     }
     if (hn::AllTrue(D(), r.done)) break;  // no pixels left and every ray written
-    const int rooms = marcher.step(r, x, seg, *lanes);
+    const int rooms = marcher.step(r, x, seg, held, *lanes);
     spread = analytic && rooms > 2;
     if (patience > 0) ++waited;
   }
@@ -276,13 +278,15 @@ int64_t RoomSteps(const PacketJob& job, int64_t repeats) {
   Relaxation start_x, x;
   Segment start_seg, seg;
   CentralPacket(job, marcher, start, start_x, start_seg);
+  HeldEdges held;
+  Marcher::clear(held);
   LaneCounts lanes;
   V sum = Splat(0.0f);  // of the steps' results, so that none is left out as unused
   for (int64_t k = 0; k < repeats; ++k) {
     r = start;
     x = start_x;
     seg = start_seg;
-    marcher.step(r, x, seg, lanes);
+    marcher.step(r, x, seg, held, lanes);
     sum = sum + r.t + r.ox + r.oy + r.oz;
   }
   volatile float sink = hn::GetLane(sum);
@@ -298,13 +302,15 @@ int TraceRay(const PacketJob& job, const Ray& ray, int max_events,
   Packet r;
   Relaxation x;
   Segment seg;
+  HeldEdges held;
   Marcher::clear(r, x, seg);
+  Marcher::clear(held);
   const glm::vec3 from(ray.from), dir(ray.dir);
   marcher.start(r, x, seg, hn::FirstN(D(), 1), ray.polygon, Splat(from.x), Splat(from.y),
                 Splat(from.z), Splat(dir.x), Splat(dir.y), Splat(dir.z));
   LaneCounts lanes;
   for (int i = 0; i < job.tables->params.max_steps && !hn::AllTrue(D(), r.done); ++i)
-    marcher.step(r, x, seg, lanes);
+    marcher.step(r, x, seg, held, lanes);
   return hn::GetLane(r.steps);
 }
 

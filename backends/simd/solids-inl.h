@@ -25,7 +25,16 @@ class Solids {
       : polygons_(tables.polygons.data()),
         objects_(tables.objects.data()),
         params_(tables.params),
-        features_(tables.features) {}
+        features_(tables.features),
+        count_(static_cast<int>(tables.objects.size())) {
+    if (tables.objects.size() > room_of_.size()) return;
+    for (size_t p = 0; p < tables.polygons.size(); ++p)
+      for (int k = tables.polygons[p].z; k < tables.polygons[p].z + tables.polygons[p].w; ++k)
+        room_of_[static_cast<size_t>(k)] = static_cast<int>(p);
+  }
+
+  // Whether a whole pass may read the solids by lane (few enough in the scene).
+  bool by_lane() const { return count_ <= static_cast<int>(room_of_.size()); }
 
   // Signed distance from p to solid k of the object table.
   FLATMARCH_PACKET_INLINE V solid_distance(int k, V px, V py, V pz) const {
@@ -40,6 +49,17 @@ class Solids {
     best.d = Splat(kFar);
     best.object = SplatI(-1);
     if (!has(kFeatureObjects)) return best;
+    if (rooms.whole) {  // every solid of the scene, for the lanes in its room
+      for (int k = 0; k < count_; ++k) {
+        const M in = hn::And(rooms.all, Equal(rooms.polygons, room_of_[static_cast<size_t>(k)]));
+        if (!Any(in)) continue;
+        const V dk = solid_distance(k, px, py, pz);
+        const M nearer = hn::And(in, dk < best.d);
+        best.d = Select(nearer, dk, best.d);
+        best.object = Select(nearer, SplatI(k), best.object);
+      }
+      return best;
+    }
     for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
       const ivec4 poly = polygons_[rooms.polygon[i]];
       for (int k = poly.z; k < poly.z + poly.w; ++k) {
@@ -83,6 +103,8 @@ class Solids {
   const ObjectRecord* objects_;
   KernelParams params_;
   uint features_;
+  int count_;                        // solids in the scene
+  std::array<int, 8> room_of_ = {};  // of each, where by_lane()
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)

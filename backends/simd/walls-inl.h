@@ -55,6 +55,9 @@ class Walls {
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
     mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
     if (mode_ == kSingle) return;
+    held_ = tables.params.method != kMethodAnalytic && tables.polygons.size() > 1 &&
+            std::all_of(tables.polygons.begin(), tables.polygons.end(),
+                        [](const ivec4& p) { return p.y <= kHeldEdges; });
     // Zero up to whole vectors, for the lookup's loads.
     const size_t filled = std::max(edges, vectors_ * lanes);
     for (size_t f = 0; f < kFields; ++f) {
@@ -99,6 +102,30 @@ class Walls {
 
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
   bool merge() const { return mode_ != kSingle; }
+  // Whether passes over several rooms read the edges each lane holds (HeldEdges).
+  bool held() const { return held_; }
+  // Where held(): the lanes of `m` in `polygon` take their room's edges where they do not hold
+  // them yet, one broadcast per number of each room taken.
+  FLATMARCH_PACKET_INLINE void hold(HeldEdges& held, VI polygon, M m) const {
+    const M stale = hn::AndNot(hn::RebindMask(D(), held.polygon == polygon), m);
+    if (!Any(stale)) return;
+    std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
+    hn::StoreU(polygon, DI(), lane_rooms.data());
+    for (M left = stale; Any(left);) {  // bounded: every turn takes at least one lane
+      const int p = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
+      const M in = hn::And(left, Equal(polygon, p));
+      left = hn::AndNot(in, left);
+      const ivec4 poly = polygons_[p];
+      for (int k = 0; k < poly.y; ++k)
+        for (const Field f : kHeldFields) {
+          V& v = held.number[static_cast<size_t>(k)][f];
+          v = Select(in, Splat(lookup_[f][static_cast<size_t>(poly.x + k)]), v);
+        }
+      held.edge_count = Select(in, SplatI(poly.y), held.edge_count);
+    }
+    held.polygon = Select(stale, polygon, held.polygon);
+  }
+
   // Whether crossings look each lane's gluing up in vectors (cross_glued). Where the edges do
   // not fit in two, a crossing takes a round per edge crossed: a gather of each lane's gluing
   // made the cube's and the staircases' analytic frames 1.4-1.5x slower (measured).
@@ -157,20 +184,26 @@ class Walls {
     return inside;
   }
 
+  // `held`: the edges the lanes hold, read instead of the tables where not null (a whole pass).
   template <bool kOneRoom>
-  FLATMARCH_PACKET_INLINE WallDistance wall_distance(const Rooms& rooms, V px, V py) const {
+  FLATMARCH_PACKET_INLINE WallDistance wall_distance(const Rooms& rooms, const HeldEdges* held,
+                                                     V px, V py) const {
     V best = Splat(kFar), second = Splat(kFar);
     VI edge = SplatI(-1);
     M inside = None();
     for (int k = 0; k < rooms.most_edges; ++k) {
       const Slot at = slot<kOneRoom>(rooms, k);
       const M valid = at.valid;
-      const V ax = field<kOneRoom>(at, kAx);
-      const V ay = field<kOneRoom>(at, kAy);
-      const V abx = field<kOneRoom>(at, kAbx);
-      const V aby = field<kOneRoom>(at, kAby);
-      const V w = field<kOneRoom>(at, kInvLength2);
-      const V ay_aby = field<kOneRoom>(at, kAyAby);
+      const auto read = [&](Field f) HWY_ATTR {
+        if (!kOneRoom && held) return held->number[static_cast<size_t>(k)][f];
+        return field<kOneRoom>(at, f);
+      };
+      const V ax = read(kAx);
+      const V ay = read(kAy);
+      const V abx = read(kAbx);
+      const V aby = read(kAby);
+      const V w = read(kInvLength2);
+      const V ay_aby = read(kAyAby);
       const lane::vec2 ap(px - ax, py - ay), ab(abx, aby);
       const V d2 = lane::segment_distance2(ap, ab, w).v;
       const M nearest = hn::And(valid, d2 < best);
@@ -308,6 +341,7 @@ class Walls {
 
   // How a pass over several rooms reads its lanes' edges.
   enum Mode { kSingle, kTable, kBlend } mode_ = kSingle;
+  bool held_ = false;  // held()
   // kTable's vectors a table, one or two. In two: 16 lanes, the cube's 24 edges, frames
   // 1.2-1.25x faster than with broadcasts blended by room (kBlend); 8 lanes, the double
   // pentagon's 10 edges, 1.04-1.1x. In three, 4 lanes, the double pentagon was 3-7% slower than
