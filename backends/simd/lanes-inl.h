@@ -162,7 +162,7 @@ enum Field { kAx, kAy, kAbx, kAby, kAyAby, kNx, kNy, kNa, kInvLength2, kToleranc
 // hold (Walls::hold), so that such a pass reads each lane's edges with a load instead of a
 // lookup or a broadcast per room blended by lane. A ray crosses once every 20-100 steps there,
 // so a lane's edges are taken far less often than they are read.
-constexpr int kHeldEdges = 4;
+constexpr int kHeldEdges = 5;
 constexpr std::array<Field, 6> kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
 struct HeldEdges {
   VI polygon;                                             // the room each lane holds, -1: none

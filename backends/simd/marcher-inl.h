@@ -127,7 +127,7 @@ class Marcher {
         rooms.whole = true;
         rooms.all = pending;
         rooms.polygons = r.polygon;
-        rooms.most_edges = kHeldEdges;
+        rooms.most_edges = walls_.most_edges();
         rooms.first_edge = SplatI(0);
         rooms.edge_count = held.edge_count;
         lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pending));

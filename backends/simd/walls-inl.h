@@ -55,6 +55,7 @@ class Walls {
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
     mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
     if (mode_ == kSingle) return;
+    for (const ivec4& p : tables.polygons) most_edges_ = std::max(most_edges_, p.y);
     held_ = tables.params.method != kMethodAnalytic && tables.polygons.size() > 1 &&
             std::all_of(tables.polygons.begin(), tables.polygons.end(),
                         [](const ivec4& p) { return p.y <= kHeldEdges; });
@@ -104,6 +105,8 @@ class Walls {
   bool merge() const { return mode_ != kSingle; }
   // Whether passes over several rooms read the edges each lane holds (HeldEdges).
   bool held() const { return held_; }
+  // The most edges a room of the scene has.
+  int most_edges() const { return most_edges_; }
   // Where held(): the lanes of `m` in `polygon` take their room's edges where they do not hold
   // them yet, one broadcast per number of each room taken.
   FLATMARCH_PACKET_INLINE void hold(HeldEdges& held, VI polygon, M m) const {
@@ -191,7 +194,10 @@ class Walls {
     V best = Splat(kFar), second = Splat(kFar);
     VI edge = SplatI(-1);
     M inside = None();
-    for (int k = 0; k < rooms.most_edges; ++k) {
+    // Held edges: a loop of a constant count, unrolled.
+    const int most = held ? kHeldEdges : rooms.most_edges;
+    for (int k = 0; k < most; ++k) {
+      if (held && k >= rooms.most_edges) break;
       const Slot at = slot<kOneRoom>(rooms, k);
       const M valid = at.valid;
       const auto read = [&](Field f) HWY_ATTR {
@@ -342,6 +348,7 @@ class Walls {
   // How a pass over several rooms reads its lanes' edges.
   enum Mode { kSingle, kTable, kBlend } mode_ = kSingle;
   bool held_ = false;  // held()
+  int most_edges_ = 0;
   // kTable's vectors a table, one or two. In two: 16 lanes, the cube's 24 edges, frames
   // 1.2-1.25x faster than with broadcasts blended by room (kBlend); 8 lanes, the double
   // pentagon's 10 edges, 1.04-1.1x. In three, 4 lanes, the double pentagon was 3-7% slower than
