@@ -7,12 +7,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <numeric>
 
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/simd.hpp"
 #include "reports/surfaces.hpp"
+#include "scene/load.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
 
@@ -127,6 +131,35 @@ TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
         expect_identical(n,
                          "staircase " + std::to_string(squares) + " " + to_string(m) + " " + isa);
       }
+    }
+  }
+}
+
+// Rays over several rooms in one pass (Rooms::whole) meeting walls and solids of several rooms:
+// the cube with two of its edges made opaque walls and a second solid in another face. Every
+// instruction set and method gives the scalar frame.
+TEST(Simd, WholePassesOverWallsAndSolidsAgreeWithScalar) {
+  nlohmann::json doc = nlohmann::json::parse(
+      std::ifstream(std::filesystem::path(FLATMARCH_SOURCE_DIR) / "scenes" / "cube.json"));
+  nlohmann::json& gluings = doc["gluings"];
+  ASSERT_EQ(gluings.back(), nlohmann::json::parse("[[5, 0], [2, 0]]"));
+  gluings.erase(gluings.size() - 1);
+  doc["boundaries"] = nlohmann::json::parse(
+      R"([{"edge": [5, 0], "boundary": "wall"}, {"edge": [2, 0], "boundary": "wall"}])");
+  doc["objects"].push_back(nlohmann::json::parse(
+      R"({"type": "sphere", "polygon": 3, "center": [-1, 1, 1], "radius": 0.4})"));
+  const Scene scene = parse_scene(doc.dump(), "cube with walls");
+  for (Method m : kKernelMethods) {
+    MarchParams params;
+    params.method = m;
+    const Frame scalar = ScalarBackend().render(scene, scene.camera, 96, 54, params, {});
+    size_t walls = 0;
+    for (float h : scalar.hit) walls += h == kHitWall;
+    EXPECT_GT(walls, 100u) << to_string(m) << ": the walls are seen";
+    for (const std::string& isa : simd::isa_names(true)) {
+      const Agreement n = compare(
+          scalar, SimdBackend({.isa = isa}).render(scene, scene.camera, 96, 54, params, {}));
+      expect_identical(n, std::string("cube with walls ") + to_string(m) + " " + isa);
     }
   }
 }

@@ -166,7 +166,7 @@ constexpr int kHeldEdges = 5;
 constexpr std::array<Field, 6> kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
 struct HeldEdges {
   VI polygon;                                             // the room each lane holds, -1: none
-  VI edge_count;                                          // its edges
+  VI first_edge, edge_count;                              // its edges in the edge table
   std::array<std::array<V, kFields>, kHeldEdges> number;  // [edge][field], kHeldFields only
 };
 inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra) {

@@ -50,13 +50,14 @@ class Marcher {
         features_(tables.features),
         events_(events),
         max_events_(max_events),
-        whole_(walls_.held() && !has(kFeatureWalls) && solids_.by_lane()) {}
+        whole_(tables.polygons.size() > 1 && solids_.by_lane() &&
+               walls_.whole(params_.method == kMethodAnalytic)) {}
 
   // A packet with no rays: every lane done.
   // Edges held by no lane.
   static void clear(HeldEdges& held) {
     held.polygon = SplatI(-1);
-    held.edge_count = SplatI(0);
+    held.first_edge = held.edge_count = SplatI(0);
     for (auto& edge : held.number) edge.fill(Splat(0.0f));
   }
 
@@ -122,19 +123,30 @@ class Marcher {
       // take the one-room pass below.
       const int first = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
       if (!hn::AllFalse(D(), hn::AndNot(Equal(r.polygon, first), pending))) {
-        walls_.hold(held, r.polygon, pending);
         Rooms rooms;
         rooms.whole = true;
         rooms.all = pending;
         rooms.polygons = r.polygon;
         rooms.most_edges = walls_.most_edges();
-        rooms.first_edge = SplatI(0);
-        rooms.edge_count = held.edge_count;
+        const bool hold = !analytic && walls_.held();
+        if (hold) {
+          walls_.hold(held, r.polygon, pending);
+          rooms.first_edge = held.first_edge;
+          rooms.edge_count = held.edge_count;
+        } else {
+          walls_.room_edges(r.polygon, pending, rooms.first_edge, rooms.edge_count);
+        }
         lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pending));
         lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
-        sphere_step<false>(r, x, pending, rooms, &held);
+        // Three calls, so that each inlined copy knows whether it reads held edges.
+        if (analytic)
+          analytic_step<false>(r, seg, pending, rooms);
+        else if (hold)
+          sphere_step<false>(r, x, pending, rooms, &held);
+        else
+          sphere_step<false>(r, x, pending, rooms, nullptr);
         pending = None();
-        rooms_seen = 2;  // several
+        rooms_seen = 3;  // several
       }
     }
     while (Any(pending)) {

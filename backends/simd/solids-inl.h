@@ -76,6 +76,17 @@ class Solids {
   FLATMARCH_PACKET_INLINE V solid_entry(const Rooms& rooms, const Packet& r) const {
     V first = Splat(kFar);
     const lane::vec3 o(r.ox, r.oy, r.oz), d(r.dx, r.dy, r.dz);
+    if (rooms.whole) {  // every solid of the scene, for the lanes in its room
+      for (int k = 0; k < count_; ++k) {
+        const M in = hn::And(rooms.all, Equal(rooms.polygons, room_of_[static_cast<size_t>(k)]));
+        if (!Any(in)) continue;
+        const glm::vec4 c = objects_[k].center;
+        const V entry =
+            lane::sphere_entry(o - lane::vec3(lane::Broadcast(c)), d, c.w + params_.eps).v;
+        first = Select(in, hn::Min(first, entry), first);
+      }
+      return first;
+    }
     for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
       const ivec4 poly = polygons_[rooms.polygon[i]];
       for (int k = poly.z; k < poly.z + poly.w; ++k) {

@@ -69,7 +69,12 @@ class Walls {
     if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
     std::fill_n(first_edge_.begin(), filled, 0);
-    for (size_t p = 0; p < tables.polygons.size(); ++p) first_edge_[p] = tables.polygons[p].x;
+    std::fill_n(edge_count_.begin(), filled, 0);
+    for (size_t p = 0; p < tables.polygons.size(); ++p) {
+      first_edge_[p] = tables.polygons[p].x;
+      edge_count_[p] = tables.polygons[p].y;
+    }
+    std::fill_n(wall_.begin(), filled, 0);
     for (auto& g : glue_) std::fill_n(g.begin(), filled, 0.0f);
     std::fill_n(to_polygon_.begin(), filled, 0);
     for (size_t e = 0; e < edges; ++e) {
@@ -98,6 +103,7 @@ class Walls {
                                                 edge.tint.w};
       for (size_t f = 0; f < kGlueFields; ++f) glue_[f][e] = glue[f];
       to_polygon_[e] = link.x == kEdgeGlued ? link.y : 0;
+      wall_[e] = link.x == kEdgeWall ? -1 : 0;
     }
   }
 
@@ -124,6 +130,7 @@ class Walls {
           V& v = held.number[static_cast<size_t>(k)][f];
           v = Select(in, Splat(lookup_[f][static_cast<size_t>(poly.x + k)]), v);
         }
+      held.first_edge = Select(in, SplatI(poly.x), held.first_edge);
       held.edge_count = Select(in, SplatI(poly.y), held.edge_count);
     }
     held.polygon = Select(stale, polygon, held.polygon);
@@ -133,6 +140,19 @@ class Walls {
   // not fit in two, a crossing takes a round per edge crossed: a gather of each lane's gluing
   // made the cube's and the staircases' analytic frames 1.4-1.5x slower (measured).
   bool glue_by_lane() const { return mode_ == kTable; }
+  // Whether a pass over several rooms may read each lane's edges by its room alone (a whole
+  // pass, Rooms::whole): where they are held (held()) or looked up in vectors (glue_by_lane()).
+  // Where the scene has walls, only the lookup says which edges are walls.
+  bool whole(bool analytic) const {
+    if (mode_ == kTable) return true;
+    return !analytic && held_ && !has(kFeatureWalls);
+  }
+  // The first edge and the edge count of each lane's room, looked up (glue_by_lane()).
+  FLATMARCH_PACKET_INLINE void room_edges(VI polygon, M m, VI& first, VI& count) const {
+    const VI at = Select(m, polygon, SplatI(0));
+    first = lookup(DI(), first_edge_, at);
+    count = lookup(DI(), edge_count_, at);
+  }
 
   // Edge k of each lane's room: its index in the edge table (0 where the room has fewer
   // edges), and the lanes whose room has one.
@@ -270,6 +290,11 @@ class Walls {
   FLATMARCH_PACKET_INLINE M is_wall(const Rooms& rooms, VI edge) const {
     M wall = None();
     if (!has(kFeatureWalls)) return wall;
+    if (rooms.whole) {  // by lookup (whole())
+      const M valid = hn::And(rooms.all, AtLeastZero(edge));
+      const VI at = Select(valid, rooms.first_edge + edge, SplatI(0));
+      return hn::And(valid, hn::RebindMask(D(), lookup(DI(), wall_, at) != SplatI(0)));
+    }
     for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
       const ivec4 poly = polygons_[rooms.polygon[i]];
       for (int k = 0; k < poly.y; ++k)
@@ -282,6 +307,10 @@ class Walls {
   // The inward unit normal of each lane's opaque wall `edge` of its room (for the rays of `m`).
   FLATMARCH_PACKET_INLINE lane::vec2 wall_normal(M m, const Rooms& rooms, VI edge) const {
     V nx = Splat(0.0f), ny = Splat(0.0f);
+    if (rooms.whole) {  // by lookup (whole()): the edge's line's normal is in glue_
+      const VI at = Select(m, rooms.first_edge + edge, SplatI(0));
+      return {hn::Neg(lookup(D(), glue_[9], at)), hn::Neg(lookup(D(), glue_[10], at))};
+    }
     for (size_t i = 0; i < static_cast<size_t>(rooms.count); ++i) {
       const ivec4 poly = polygons_[rooms.polygon[i]];
       for (int k = 0; k < poly.y; ++k) {
@@ -360,7 +389,8 @@ class Walls {
   // (3), its own line's normal (2) and its tint (4); and the destination polygon.
   static constexpr size_t kGlueFields = 15;
   std::array<Table<float>, kGlueFields> glue_;
-  Table<int32_t> to_polygon_, first_edge_;
+  Table<int32_t> to_polygon_, first_edge_, edge_count_;
+  Table<int32_t> wall_;  // of each edge: -1 an opaque wall, else 0
   KernelParams params_;
   uint features_;
 };
