@@ -136,7 +136,8 @@ struct Segment {
 // or, where the edges do not fit in two, each room's record broadcast and blended by lane (scenes
 // of over Walls::kMostEdges edges take one room a pass). Coherent rays are mostly in one room; rays
 // split between a few (the double pentagon's two, at every crossing) or spread over many (the
-// cube, a staircase) still take one pass a step, not one per room. 8 rooms a pass against 4:
+// cube, a staircase) still take one pass a step, not one per room (where Walls::whole, one whole
+// pass whatever their number: Rooms::whole). 8 rooms a pass against 4:
 // frames level, lanes busy 0.84 -> 0.90 on the cube and 0.83 -> 0.96 on 32- and 128-square
 // staircases (sphere tracing, 640x360, one run).
 constexpr int kRoomsPerPass = 8;
@@ -148,7 +149,8 @@ struct Rooms {
   M all;                               // the lanes of the pass
   VI first_edge, edge_count;           // of each lane's room, when there are several
   // A pass over every unfinished lane whatever its room (Marcher::step's whole passes): `count`
-  // is 0, each lane's room is in `polygons` and its edges are held (HeldEdges).
+  // is 0, each lane's room is in `polygons`, and its edges are held (HeldEdges) or looked up in
+  // vectors by first_edge and edge_count (Walls::whole).
   bool whole = false;
   VI polygons;
 };
@@ -156,19 +158,6 @@ struct Rooms {
 // The numbers of an edge the packet code reads, by name.
 enum Field { kAx, kAy, kAbx, kAby, kAyAby, kNx, kNy, kNa, kInvLength2, kTolerance, kFields };
 
-// Sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges each (the
-// cube, the staircases): each lane holds the numbers of its room's edges that a step reads
-// (kHeldFields), taken when a pass over several rooms first finds the lane in a room it does not
-// hold (Walls::hold), so that such a pass reads each lane's edges with a load instead of a
-// lookup or a broadcast per room blended by lane. A ray crosses once every 20-100 steps there,
-// so a lane's edges are taken far less often than they are read.
-constexpr int kHeldEdges = 5;
-constexpr std::array<Field, 6> kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
-struct HeldEdges {
-  VI polygon;                                             // the room each lane holds, -1: none
-  VI first_edge, edge_count;                              // its edges in the edge table
-  std::array<std::array<V, kFields>, kHeldEdges> number;  // [edge][field], kHeldFields only
-};
 inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra) {
   switch (f) {
     case kAx:
@@ -197,6 +186,24 @@ inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, gl
   return 0.0f;
 }
 
+// Sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges each (the
+// cube, the staircases): each lane holds the numbers of its room's edges that a step reads
+// (kHeldFields), taken when a pass over several rooms first finds the lane in a room it does not
+// hold (Walls::hold), so that such a pass reads each lane's edges with a load instead of a
+// lookup or a broadcast per room blended by lane. A ray crosses once every 20-100 steps there,
+// so a lane's edges are taken far less often than they are read. With the whole passes this
+// allows (Rooms::whole), against passes of up to eight rooms blended or looked up (640x360, 2
+// cores, AVX-512, interleaved rounds): staircases of 32 and 128 squares 0.56-0.60x the time,
+// the cube 0.74x, the pillowcase 0.88x; the double pentagon's five edges 0.85-0.92x (0.80x on
+// AVX2, 0.73x on SSE4). The analytic method crosses at almost every step, and holding its edges
+// made it 1.05-1.2x slower.
+constexpr int kHeldEdges = 5;
+constexpr std::array<Field, 6> kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
+struct HeldEdges {
+  VI polygon;                                             // the room each lane holds, -1: none
+  VI first_edge, edge_count;                              // its edges in the edge table
+  std::array<std::array<V, kFields>, kHeldEdges> number;  // [edge][field], kHeldFields only
+};
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
 }  // namespace flatmarch::simd

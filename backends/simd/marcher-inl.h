@@ -5,11 +5,12 @@
 // -ffp-contract=off), so that a lane takes exactly the steps the scalar backend takes.
 //
 // What differs is control flow. Where the kernel branches, a packet computes under masks and
-// blends. The tables are read per room, not per lane: a step runs in passes over a few rooms
-// among the packet's unfinished rays, and a table read is one record per room, broadcast and
-// blended (a coherent tile's rays are mostly in one room, so this is usually one broadcast; no
-// gathers). A lane whose ray has ended is masked off until it takes the next pixel; the share
-// of lanes doing work in a pass is the lane utilisation the benchmark reports.
+// blends. The tables are read per room, not per lane: rays in one room read its records by
+// broadcast (a coherent tile's rays mostly are); rays over several rooms take one whole pass
+// where each lane's edges can be read by its room alone (held by the lane, or looked up in one
+// or two vectors: Walls::whole), else passes over a few rooms each, their records broadcast and
+// blended (no gathers). A lane whose ray has ended is masked off until it takes the next pixel;
+// the share of lanes doing work in a pass is the lane utilisation the benchmark reports.
 //
 // Included by packet.cpp once per instruction set.
 

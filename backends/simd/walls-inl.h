@@ -1,8 +1,9 @@
 // The walls of a pass's rooms for packets of rays: distances to them, where rays leave by them,
 // which are opaque, and what a gluing does to the rays that cross one (march.glsl's "Walls").
 // A pass's table reads are one broadcast record per room, or, where a pass spans several rooms,
-// a lookup of each lane's edge in one or two vectors holding the scene's edges (or, for more
-// edges, a broadcast per room blended by lane).
+// a load of the edges each lane holds (HeldEdges: sphere and relaxed tracing in rooms of at most
+// kHeldEdges edges), a lookup of each lane's edge in one or two vectors holding the scene's
+// edges, or, for more edges, a broadcast per room blended by lane.
 
 // Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
 // re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
