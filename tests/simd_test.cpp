@@ -164,6 +164,29 @@ TEST(Simd, WholePassesOverWallsAndSolidsAgreeWithScalar) {
   }
 }
 
+// Whole passes whose lanes look their edges up rather than hold them (a room of more than
+// kHeldEdges edges): an L-shaped hexagon and a square glued edge to edge, a solid in the square.
+TEST(Simd, WholePassesLookingEdgesUpAgreeWithScalar) {
+  const Scene scene = parse_scene(R"({
+    "polygons": [[[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]],
+                 [[3, 0], [4, 0], [4, 1], [3, 1]]],
+    "gluings": [[[0, 1], [1, 3]], [[0, 3], [1, 1]], [[0, 2], [1, 0]], [[0, 4], [1, 2]],
+                [[0, 0], [0, 5]]],
+    "objects": [{"type": "sphere", "polygon": 1, "center": [3.5, 0.5, 1], "radius": 0.2}],
+    "camera": {"polygon": 0, "position": [0.5, 0.5, 1.0], "yaw_deg": 20, "pitch_deg": -5}})",
+                                  "hexagon and square");
+  for (Method m : kKernelMethods) {
+    MarchParams params;
+    params.method = m;
+    const Frame scalar = ScalarBackend().render(scene, scene.camera, 96, 54, params, {});
+    for (const std::string& isa : simd::isa_names(true)) {
+      const Agreement n = compare(
+          scalar, SimdBackend({.isa = isa}).render(scene, scene.camera, 96, 54, params, {}));
+      expect_identical(n, std::string("hexagon and square ") + to_string(m) + " " + isa);
+    }
+  }
+}
+
 // A trace follows lane 0 of a packet: the same events as the scalar kernel's, in the same
 // places, for rays through a few pixels of every scene.
 TEST(Simd, TracesMatchScalar) {

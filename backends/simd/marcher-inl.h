@@ -54,7 +54,6 @@ class Marcher {
         whole_(tables.polygons.size() > 1 && solids_.by_lane() &&
                walls_.whole(params_.method == kMethodAnalytic)) {}
 
-  // A packet with no rays: every lane done.
   // Edges held by no lane.
   static void clear(HeldEdges& held) {
     held.polygon = SplatI(-1);
@@ -62,6 +61,7 @@ class Marcher {
     for (auto& edge : held.number) edge.fill(Splat(0.0f));
   }
 
+  // A packet with no rays: every lane done.
   static void clear(Packet& r, Relaxation& x, Segment& seg) {
     r.polygon = r.steps = r.crossings = r.hit = SplatI(0);
     r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = r.t = Splat(0.0f);
@@ -121,8 +121,8 @@ class Marcher {
     M pending = active;
     const bool analytic = params_.method == kMethodAnalytic;
     if (whole_ && Any(pending)) {
-      // Rays over several rooms take one pass, reading the edges they hold; rays in one room
-      // take the one-room pass below.
+      // Rays over several rooms take one pass, reading the edges they hold or looking them up
+      // by their rooms; rays in one room take the one-room pass below.
       const int first = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
       if (!hn::AllFalse(D(), hn::AndNot(Equal(r.polygon, first), pending))) {
         Rooms rooms;
@@ -486,8 +486,9 @@ class Marcher {
   uint features_;
   std::vector<kernel::KernelEvent>* events_;
   int max_events_;
-  // Sphere and relaxed tracing where rooms have at most kHeldEdges edges, no wall and few
-  // solids: rays over several rooms take one pass a step, whatever their rooms.
+  // Rays over several rooms take one whole pass a step, whatever their rooms (Rooms::whole):
+  // in scenes of several rooms and few solids whose edges the lanes can hold or look up
+  // (Walls::whole).
   bool whole_;
 };
 

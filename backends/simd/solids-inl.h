@@ -114,8 +114,12 @@ class Solids {
   const ObjectRecord* objects_;
   KernelParams params_;
   uint features_;
-  int count_;                        // solids in the scene
-  std::array<int, 8> room_of_ = {};  // of each, where by_lane()
+  int count_;  // solids in the scene
+  // The room of each solid, where by_lane(): a whole pass computes every solid's distance for
+  // the lanes in its room, a loop over the scene's solids, so only where they are few (the
+  // gallery's scenes of several rooms have one or two).
+  static constexpr size_t kMostByLane = 8;
+  std::array<int, kMostByLane> room_of_ = {};
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)

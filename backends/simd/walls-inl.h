@@ -110,7 +110,8 @@ class Walls {
 
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
   bool merge() const { return mode_ != kSingle; }
-  // Whether passes over several rooms read the edges each lane holds (HeldEdges).
+  // Whether whole passes read the edges each lane holds (HeldEdges) rather than look them up:
+  // sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges.
   bool held() const { return held_; }
   // The most edges a room of the scene has.
   int most_edges() const { return most_edges_; }
