@@ -125,21 +125,9 @@ class Marcher {
       // by their rooms; rays in one room take the one-room pass below.
       const int first = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
       if (!hn::AllFalse(D(), hn::AndNot(Equal(r.polygon, first), pending))) {
-        Rooms rooms;
-        rooms.whole = true;
-        rooms.all = pending;
-        rooms.polygons = r.polygon;
-        rooms.most_edges = walls_.most_edges();
         const bool hold = !analytic && walls_.held();
-        if (hold) {
-          walls_.hold(held, r.polygon, pending);
-          rooms.first_edge = held.first_edge;
-          rooms.edge_count = held.edge_count;
-        } else {
-          walls_.room_edges(r.polygon, pending, rooms.first_edge, rooms.edge_count);
-        }
-        lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pending));
-        lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
+        const Rooms rooms = walls_.whole_pass(r.polygon, pending, hold ? &held : nullptr);
+        count_lanes(lanes, pending);
         // Three calls, so that each inlined copy knows whether it reads held edges.
         if (analytic)
           analytic_step<false>(r, seg, pending, rooms);
@@ -173,8 +161,7 @@ class Marcher {
         left = hn::AndNot(in, left);
       }
       rooms.all = pass;
-      lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
-      lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
+      count_lanes(lanes, pass);
       if (rooms.count == 1 && analytic) {
         analytic_step<true>(r, seg, pass, rooms);
       } else if (rooms.count == 1) {
@@ -194,6 +181,12 @@ class Marcher {
 
  private:
   bool has(uint feature) const { return (features_ & feature) != 0u; }
+
+  // A pass over the lanes of `pass`.
+  static void count_lanes(LaneCounts& lanes, M pass) {
+    lanes.active += static_cast<int64_t>(hn::CountTrue(D(), pass));
+    lanes.slots += static_cast<int64_t>(hn::Lanes(D()));
+  }
 
   // Records an event of lane 0 (the one a trace follows) when it is in `m`.
   FLATMARCH_PACKET_INLINE void record(M m, int kind, VI polygon, VI edge, int to_polygon,

@@ -149,11 +149,25 @@ class Walls {
     if (mode_ == kTable) return true;
     return !analytic && held_ && !has(kFeatureWalls);
   }
-  // The first edge and the edge count of each lane's room, looked up (glue_by_lane()).
-  FLATMARCH_PACKET_INLINE void room_edges(VI polygon, M m, VI& first, VI& count) const {
-    const VI at = Select(m, polygon, SplatI(0));
-    first = lookup(DI(), first_edge_, at);
-    count = lookup(DI(), edge_count_, at);
+  // A whole pass over the lanes of `m` in their rooms `polygon`: each lane's edges held, taken
+  // now where the lane does not hold them yet (`held` not null, held()), or its room's first
+  // edge and edge count looked up (glue_by_lane()).
+  FLATMARCH_PACKET_INLINE Rooms whole_pass(VI polygon, M m, HeldEdges* held) const {
+    Rooms rooms;
+    rooms.whole = true;
+    rooms.all = m;
+    rooms.polygons = polygon;
+    rooms.most_edges = most_edges_;
+    if (held) {
+      hold(*held, polygon, m);
+      rooms.first_edge = held->first_edge;
+      rooms.edge_count = held->edge_count;
+    } else {
+      const VI at = Select(m, polygon, SplatI(0));
+      rooms.first_edge = lookup(DI(), first_edge_, at);
+      rooms.edge_count = lookup(DI(), edge_count_, at);
+    }
+    return rooms;
   }
 
   // Edge k of each lane's room: its index in the edge table (0 where the room has fewer
