@@ -9,15 +9,43 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 extern char** environ;
 
 namespace flatmarch::test {
 
 namespace {
+
+// The folders make_temp_dir made, removed when the test program exits (each test of ctest is its
+// own process), so a run of the suite leaves nothing behind. FLATMARCH_KEEP_TEST_FILES=1 keeps
+// them for looking at.
+class TempDirs {
+ public:
+  ~TempDirs() {
+    const char* keep = std::getenv("FLATMARCH_KEEP_TEST_FILES");
+    if (keep && *keep && std::string(keep) != "0") return;
+    std::error_code ignored;
+    for (const std::string& dir : dirs_) std::filesystem::remove_all(dir, ignored);
+  }
+  void add(std::string dir) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    dirs_.push_back(std::move(dir));
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> dirs_;
+};
+
+TempDirs& temp_dirs() {
+  static TempDirs dirs;
+  return dirs;
+}
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -38,6 +66,7 @@ std::string vec3_arg(Vec3 v) {
 std::string make_temp_dir() {
   std::string pattern = (std::filesystem::temp_directory_path() / "flatmarch-test-XXXXXX").string();
   if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+  temp_dirs().add(pattern);
   return pattern;
 }
 

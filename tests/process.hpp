@@ -25,7 +25,8 @@ ProcessResult run_flatmarch(const std::vector<std::string>& args, double timeout
 // A vector as a command-line argument X,Y,Z, with every digit a double has.
 std::string vec3_arg(Vec3 v);
 
-// A fresh empty directory under the system's temporary directory.
+// A fresh empty directory under the system's temporary directory, removed with what it holds
+// when the test program exits (unless FLATMARCH_KEEP_TEST_FILES is set and not 0).
 std::string make_temp_dir();
 
 }  // namespace flatmarch::test
