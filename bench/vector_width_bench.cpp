@@ -1,9 +1,9 @@
 // How many float additions one core does a second in vectors of 128, 256 and 512 bits: whether
-// this CPU runs a 512-bit operation at once or as two 256-bit halves. On the second kind (AMD
-// Zen 4, some Intel parts at lower clocks) AVX-512's 16 lanes do about the work of AVX2's 8, and
-// the SIMD backend's ceiling over one scalar core is about 8 lanes a core; on the first (AMD Zen 5
-// server parts, Intel server parts) it is 16. The SIMD backend's own speed-ups are measured by
-// simd_bench; this says what they are measured against.
+// this CPU runs a 512-bit operation at once or as two 256-bit halves. On the second kind (AMD Zen
+// 4) AVX-512's 16 lanes do about the work of AVX2's 8, and the SIMD backend's ceiling over one
+// scalar core is about 8 lanes a core; on the first (AMD Zen 5 server parts, Intel's server
+// parts) it is 16. The SIMD backend's own speed-ups are measured by simd_bench; this says what
+// they are measured against.
 //
 //   vector_width_bench        # lane_adds_per_s per width; the ratio of two is the answer
 //
@@ -14,73 +14,48 @@
 #include <iostream>
 
 #if defined(__x86_64__)
-#include <immintrin.h>
-
 namespace {
 
 // Independent additions in flight: more than an adder's latency times the adders a core has, so
 // that throughput, not latency, bounds the loop; and few enough to stay in SSE's 16 registers.
 constexpr int kChains = 12;
 
-// `rounds` rounds of kChains additions, each chain a dependency of its own; returns part of their
-// sum. The loops are unrolled so that the chains stay in registers, and each sum is made opaque
-// to the compiler (an empty asm), which would otherwise fold additions that round to nothing.
-__attribute__((target("avx512f"))) float adds_512(int64_t rounds) {
-  __m512 acc[kChains];
-  const __m512 step = _mm512_set1_ps(1e-9f);
+// `rounds` rounds of kChains additions in vectors of type V (GCC's vector extensions, lowered to
+// the instruction set of the function it is inlined in), each chain a dependency of its own;
+// returns part of their sum. The loops are unrolled so that the chains stay in registers, and
+// each sum is made opaque to the compiler (an empty asm), which would otherwise fold additions
+// that round to nothing.
+template <typename V>
+[[gnu::always_inline]] inline float adds(int64_t rounds) {
+  V acc[kChains];
+  const V step = V{} + 1e-9f;
 #pragma GCC unroll 12
-  for (int c = 0; c < kChains; ++c) acc[c] = _mm512_set1_ps(static_cast<float>(c));
+  for (int c = 0; c < kChains; ++c) acc[c] = V{} + static_cast<float>(c);
   for (int64_t r = 0; r < rounds; ++r) {
 #pragma GCC unroll 12
     for (int c = 0; c < kChains; ++c) {
-      acc[c] = _mm512_add_ps(acc[c], step);
-      __asm__ volatile("" : "+x"(acc[c]));  // opaque: no addition is folded away
+      acc[c] = acc[c] + step;
+      __asm__ volatile("" : "+x"(acc[c]));
     }
   }
-  __m512 sum = acc[0];
+  V sum = acc[0];
 #pragma GCC unroll 12
-  for (int c = 1; c < kChains; ++c) sum = _mm512_add_ps(sum, acc[c]);
-  alignas(64) float lanes[16];  // not _mm512_reduce_add_ps: GCC 12 warns inside it
-  _mm512_store_ps(lanes, sum);
-  return lanes[0];
+  for (int c = 1; c < kChains; ++c) sum = sum + acc[c];
+  return sum[0];
 }
 
-__attribute__((target("avx2"))) float adds_256(int64_t rounds) {
-  __m256 acc[kChains];
-  const __m256 step = _mm256_set1_ps(1e-9f);
-#pragma GCC unroll 12
-  for (int c = 0; c < kChains; ++c) acc[c] = _mm256_set1_ps(static_cast<float>(c));
-  for (int64_t r = 0; r < rounds; ++r) {
-#pragma GCC unroll 12
-    for (int c = 0; c < kChains; ++c) {
-      acc[c] = _mm256_add_ps(acc[c], step);
-      __asm__ volatile("" : "+x"(acc[c]));  // opaque: no addition is folded away
-    }
-  }
-  __m256 sum = acc[0];
-#pragma GCC unroll 12
-  for (int c = 1; c < kChains; ++c) sum = _mm256_add_ps(sum, acc[c]);
-  alignas(32) float lanes[8];
-  _mm256_store_ps(lanes, sum);
-  return lanes[0];
-}
+using V4 = float __attribute__((vector_size(16)));
+using V8 = float __attribute__((vector_size(32)));
+using V16 = float __attribute__((vector_size(64)));
 
 float adds_128(int64_t rounds) {  // SSE2: every x86-64 CPU has it
-  __m128 acc[kChains];
-  const __m128 step = _mm_set1_ps(1e-9f);
-#pragma GCC unroll 12
-  for (int c = 0; c < kChains; ++c) acc[c] = _mm_set1_ps(static_cast<float>(c));
-  for (int64_t r = 0; r < rounds; ++r) {
-#pragma GCC unroll 12
-    for (int c = 0; c < kChains; ++c) {
-      acc[c] = _mm_add_ps(acc[c], step);
-      __asm__ volatile("" : "+x"(acc[c]));  // opaque: no addition is folded away
-    }
-  }
-  __m128 sum = acc[0];
-#pragma GCC unroll 12
-  for (int c = 1; c < kChains; ++c) sum = _mm_add_ps(sum, acc[c]);
-  return _mm_cvtss_f32(sum);
+  return adds<V4>(rounds);
+}
+__attribute__((target("avx2"))) float adds_256(int64_t rounds) {
+  return adds<V8>(rounds);
+}
+__attribute__((target("avx512f"))) float adds_512(int64_t rounds) {
+  return adds<V16>(rounds);
 }
 
 void width(benchmark::State& state, float (*adds)(int64_t), int lanes) {
