@@ -55,7 +55,7 @@ TEST(CliScalar, WarnsOfAnEpsBelowFloat32sResolutionAtAnInfiniteScenesReach) {
   // far out a ray along the cylinder meets its walls.
   const auto run = [](const std::string& scene) {
     return test::run_flatmarch({"render", FLATMARCH_SOURCE_DIR "/scenes/" + scene + ".json", "-o",
-                                testing::TempDir() + "/resolution_" + scene + ".png", "--size",
+                                test::make_temp_dir() + "/resolution_" + scene + ".png", "--size",
                                 "16x9", "--backend", "scalar", "--method", "sphere", "--eps",
                                 "1e-6", "--offset", "1e-4"});
   };
@@ -71,7 +71,7 @@ TEST(CliScalar, WarnsOfAnEpsBelowFloat32sResolutionAtAnInfiniteScenesReach) {
 TEST(CliScalar, AnInfiniteSceneKeepsRaysWithinItsModelledReach) {
   // Rays in an unbounded room must stay within 2^30 of the origin (kernel::kReach): from the
   // cone's camera a max_distance of 2e9 would take them beyond, exit 2; on the torus it is fine.
-  const std::string png = testing::TempDir() + "/reach.png";
+  const std::string png = test::make_temp_dir() + "/reach.png";
   const auto cone = test::run_flatmarch({"render", FLATMARCH_SOURCE_DIR "/scenes/cone_pi.json",
                                          "-o", png, "--size", "8x4", "--max-distance", "2e9"});
   EXPECT_EQ(cone.exit_code, 2) << cone.err;

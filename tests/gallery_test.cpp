@@ -206,7 +206,7 @@ TEST_P(GalleryScene, CameraShowsAnObjectAndMore) {
 // surface. Luminance: Rec. 709 weights of the sRGB values, as an image viewer shows them.
 TEST_P(GalleryScene, ReadsWellAsANewUserRendersIt) {
   const fs::path file = GetParam();
-  const std::string png = testing::TempDir() + "/reads_well_" + file.stem().string() + ".png";
+  const std::string png = test::make_temp_dir() + "/reads_well_" + file.stem().string() + ".png";
   const auto r = test::run_flatmarch({"render", file.string(), "-o", png, "--size", "320x180"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("/analytic"), std::string::npos) << r.err;

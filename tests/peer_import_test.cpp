@@ -394,7 +394,7 @@ std::string read_text(const fs::path& path) {
 }
 
 TEST(PeerImportCli, WritesTheSceneAndTheReport) {
-  const fs::path dir = fs::path(testing::TempDir()) / "peer_import_cli";
+  const fs::path dir = fs::path(test::make_temp_dir()) / "peer_import_cli";
   fs::create_directories(dir);
   const fs::path cube = kPeerDir / "cube.json";
   const auto r =
@@ -426,7 +426,7 @@ TEST(PeerImportCli, WritesTheSceneAndTheReport) {
 }
 
 TEST(PeerImportCli, MalformedInputExitsWith2) {
-  const fs::path dir = fs::path(testing::TempDir()) / "peer_import_cli_bad";
+  const fs::path dir = fs::path(test::make_temp_dir()) / "peer_import_cli_bad";
   fs::create_directories(dir);
   json peer = clockwise_torus();
   peer["gluing"] = {1, 2, 0, 3};

@@ -261,7 +261,7 @@ TEST(Simd, AnUnknownInstructionSetIsUnavailableAndSaysWhy) {
 
 TEST(CliSimd, IsTheDefaultOfRenderAndTakesItsOptions) {
   const std::string scene = FLATMARCH_SOURCE_DIR "/scenes/torus.json";
-  const std::string out = testing::TempDir() + "/simd_default.png";
+  const std::string out = test::make_temp_dir() + "/simd_default.png";
   const auto r = test::run_flatmarch({"render", scene, "-o", out, "--size", "16x9"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("simd/analytic"), std::string::npos) << r.err;  // render's default method
