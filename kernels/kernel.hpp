@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstddef>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -63,15 +65,28 @@ struct Kernel {
 #include "kernels/maths.glsl"
 };
 
+// The kernel specialised on kFeatures, bound to the tables (a kernel::SceneTables<real>) of a
+// scene of that feature set: for code that knows its scene's set and would not compile the
+// kFeatureCount specialisations with_kernel does (a test's scene).
+template <typename real, uint kFeatures, typename Tables>
+Kernel<real, kFeatures> bind_kernel(const Tables& tables) {
+  if (tables.features != kFeatures)
+    throw std::invalid_argument("bind_kernel: the tables are of feature set " +
+                                std::to_string(tables.features) + ", not " +
+                                std::to_string(kFeatures));
+  Kernel<real, kFeatures> k;
+  k.polygons = tables.polygons.data();
+  k.edges = tables.edges.data();
+  k.objects = tables.objects.data();
+  k.params = tables.params;
+  return k;
+}
+
 namespace detail {
 template <typename real, typename Tables, typename F, uint... N>
 void dispatch(const Tables& tables, F&& f, std::integer_sequence<uint, N...>) {
   const auto run = [&]<uint M>() {
-    Kernel<real, M> k;
-    k.polygons = tables.polygons.data();
-    k.edges = tables.edges.data();
-    k.objects = tables.objects.data();
-    k.params = tables.params;
+    Kernel<real, M> k = bind_kernel<real, M>(tables);
     f(k);
   };
   ((tables.features == N ? (run.template operator()<N>(), true) : false) || ...);

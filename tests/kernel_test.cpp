@@ -129,26 +129,27 @@ TEST(Kernel, RayEdgesAreHalfLinesWithinReach) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const auto check = [&]<typename real>(real tolerance) {
     const auto t = kernel::compile_scene<real>(s, {});
-    kernel::with_kernel<real>(t, [&](auto& k) {
-      for (int n = 0; n < 300; ++n) {
-        const double r = std::pow(10.0, 3.0 * (unit(random) + 1.0) / 2.0);  // 1 to 1000
-        const Vec2 p = r * Vec2(unit(random), unit(random));
-        if (!w.contains(p)) continue;
-        const auto d = k.wall_distance(0, glm::vec<2, real>(p));
-        EXPECT_NEAR(static_cast<double>(d.d), w.distance_to_boundary(p), tolerance * r) << n;
-        const double angle = kPi * unit(random);
-        const Vec2 dir(std::cos(angle), std::sin(angle));
-        const auto x = k.exit_edge(0, glm::vec<2, real>(p), glm::vec<2, real>(dir));
-        const Polygon::Exit want = w.exit(p, dir, 1e-9, 1e-9);
-        // A far link (edge 1, the edge at infinity, and 3 on) is no exit.
-        EXPECT_EQ(x.edge == 0 || x.edge == 2 ? x.edge : -1, want.edge) << n;
-        if (want.edge >= 0) {
-          EXPECT_NEAR(static_cast<double>(x.s), want.s, tolerance * (r + want.s)) << n;
-        } else {
-          EXPECT_GT(static_cast<double>(x.s), kernel::kReach) << n;
-        }
+    // Its one feature set, the empty one (no objects, walls, mirrors, period, scaling or floor).
+    auto k = kernel::bind_kernel<real, 0u>(t);
+    EXPECT_THROW((kernel::bind_kernel<real, kFeatureFloor>(t)), std::invalid_argument);
+    for (int n = 0; n < 300; ++n) {
+      const double r = std::pow(10.0, 3.0 * (unit(random) + 1.0) / 2.0);  // 1 to 1000
+      const Vec2 p = r * Vec2(unit(random), unit(random));
+      if (!w.contains(p)) continue;
+      const auto d = k.wall_distance(0, glm::vec<2, real>(p));
+      EXPECT_NEAR(static_cast<double>(d.d), w.distance_to_boundary(p), tolerance * r) << n;
+      const double angle = kPi * unit(random);
+      const Vec2 dir(std::cos(angle), std::sin(angle));
+      const auto x = k.exit_edge(0, glm::vec<2, real>(p), glm::vec<2, real>(dir));
+      const Polygon::Exit want = w.exit(p, dir, 1e-9, 1e-9);
+      // A far link (edge 1, the edge at infinity, and 3 on) is no exit.
+      EXPECT_EQ(x.edge == 0 || x.edge == 2 ? x.edge : -1, want.edge) << n;
+      if (want.edge >= 0) {
+        EXPECT_NEAR(static_cast<double>(x.s), want.s, tolerance * (r + want.s)) << n;
+      } else {
+        EXPECT_GT(static_cast<double>(x.s), kernel::kReach) << n;
       }
-    });
+    }
   };
   check(1e-12);
   check(1e-5f);

@@ -582,12 +582,13 @@ TEST(OracleRender, AGluedWallTintsInItsColourMoreAtGrazingIncidence) {
     // The kernel (here in float64) gathers the same.
     params.method = Method::analytic;
     const auto tables = kernel::compile_scene<double>(s, params);
-    kernel::with_kernel<double>(tables, [&](auto& k) {
-      const auto r = k.march(0, c.from, glm::normalize(c.dir));
-      EXPECT_EQ(r.crossings, 1);
-      expect_near(Vec3(r.light), a * c.colour, 1e-8);
-      EXPECT_NEAR(r.clear, 1.0 - a, 1e-12);
-    });
+    // The torus's one feature set, the empty one (no objects, walls, mirrors, period, scaling
+    // or floor): with_kernel here would compile all 64 (100 s under the sanitizers).
+    auto k = kernel::bind_kernel<double, 0u>(tables);
+    const auto r = k.march(0, c.from, glm::normalize(c.dir));
+    EXPECT_EQ(r.crossings, 1);
+    expect_near(Vec3(r.light), a * c.colour, 1e-8);
+    EXPECT_NEAR(r.clear, 1.0 - a, 1e-12);
   }
 }
 
