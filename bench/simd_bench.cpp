@@ -40,7 +40,8 @@ void simd_frame(benchmark::State& state, const Scene* scene, MarchParams params,
     benchmark::DoNotOptimize(frame.rgb.data());
   }
   bench::frame_counters(state, frame);
-  reports::simd_counters(state, simd, *scene, scene->camera, kWidth, kHeight, params, frame, lanes);
+  reports::simd_counters(state, frame, lanes,
+                         simd.peak_lane_steps(*scene, scene->camera, kWidth, kHeight, params));
   state.counters["lanes"] = simd.lanes();
 }
 

@@ -90,13 +90,12 @@ void frame_counters(benchmark::State& state, const Frame& frame);
 
 // The SIMD backend's counters of a timed frame: lane_utilisation (active lanes over lanes, of
 // `lanes`), steps_per_s (the frame's steps, summed over its rays, a second: a rate over the
-// iterations), peak_steps_per_s (SimdBackend::peak_lane_steps: one room's step on full packets
-// on all its threads) and of_peak, the share of that peak the frame's steps reach: how close to
-// what this CPU can do the backend runs (idle lanes, shading, pixel writes and scheduling make the
-// rest).
-void simd_counters(benchmark::State& state, const SimdBackend& simd, const Scene& scene,
-                   const Camera& camera, int width, int height, const MarchParams& params,
-                   const Frame& frame, const simd::LaneCounts& lanes);
+// iterations), peak_steps_per_s (`peak`, the case's SimdBackend::peak_lane_steps: one room's step
+// on full packets on all its threads; none where it is 0, no step to time) and of_peak, the share
+// of that peak the frame's steps reach: how close to what this CPU can do the backend runs (idle
+// lanes, shading, pixel writes and scheduling make the rest).
+void simd_counters(benchmark::State& state, const Frame& frame, const simd::LaneCounts& lanes,
+                   double peak);
 
 // The name register_frame_benchmark gives.
 std::string case_name(const std::string& backend, Method method, const std::string& scene,
