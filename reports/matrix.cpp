@@ -99,7 +99,8 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
   auto warmed = std::make_shared<bool>(false);
   // The SIMD backend's lane counts and peak, the same in every repetition of a case (its frames
   // are deterministic): measured in the first, the peak over 0.1 s. Each repetition's took a
-  // counted frame and 0.05 s of stepping: the regression gate 133 s -> 118 s without them.
+  // counted frame and 0.05 s of stepping: the regression gate 133 s -> 118 s measured once
+  // instead (with the peak over 0.05 s; 0.1 s adds about 4 s over its 75 SIMD cases).
   struct SimdFigures {
     bool known = false;
     simd::LaneCounts lanes;
