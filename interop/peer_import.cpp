@@ -656,7 +656,8 @@ class Importer {
     doc["description"] = description_;
     nlohmann::ordered_json vertices = nlohmann::ordered_json::array();
     for (Vec2 v : polygon_.vertices) vertices.push_back(json_vec(v));
-    doc["polygons"] = {vertices};
+    // One polygon. Spelled out: `= {vertices}` is a copy of vertices for Clang, a list for GCC.
+    doc["polygons"] = nlohmann::ordered_json::array({vertices});
     doc["gluings"] = gluings_;
     doc["height"] = tidy(2.0 * wall_height_);
     if (period_) doc["period"] = *period_;

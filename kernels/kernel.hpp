@@ -89,7 +89,7 @@ void dispatch(const Tables& tables, F&& f, std::integer_sequence<uint, N...>) {
     Kernel<real, M> k = bind_kernel<real, M>(tables);
     f(k);
   };
-  ((tables.features == N ? (run.template operator()<N>(), true) : false) || ...);
+  static_cast<void>(((tables.features == N ? (run.template operator()<N>(), true) : false) || ...));
 }
 }  // namespace detail
 

@@ -67,7 +67,7 @@ Scene regular_polygon_surface(int n) {
   nlohmann::json gluings = nlohmann::json::array();
   for (int k = 0; k < n; ++k) gluings.push_back({{0, k}, {0, k + n}});
   // Off the centre, so that no ray of the middle row runs through a cone point.
-  return scene_from_json(empty_prism({polygon}, gluings, Vec2(0.31, 0.17),
+  return scene_from_json(empty_prism(nlohmann::json::array({polygon}), gluings, Vec2(0.31, 0.17),
                                      "regular_" + std::to_string(2 * n) + "_gon"),
                          "regular_polygon_surface");
 }

@@ -433,7 +433,8 @@ json analyse_sweep(const json& points, const json& confirmations) {
     // that, of all stable points), those within 10% of the fewest mean steps, and of these the
     // one with the most stable neighbours on the grid, then the one nearest the defaults.
     std::sort(g.eps.begin(), g.eps.end());
-    const auto stable_at = [&](long e, long k) {
+    // g named in the capture: Clang 14 cannot capture a structured binding.
+    const auto stable_at = [&g = g](long e, long k) {
       if (e < 0 || k < 0 || e >= static_cast<long>(g.eps.size()) ||
           k >= static_cast<long>(g.labels.size()))
         return false;
