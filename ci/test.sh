@@ -75,8 +75,12 @@ stage "install dependencies" ci/install-deps.sh || exit 1
 stage "build (-Werror)" ci/build.sh build -DFLATMARCH_WERROR=ON "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -DNDEBUG" \
   && stage "ctest" run_ctest build
 # Only what `ctest -L unit` runs (the unit_tests target): the benchmark programs and the other
-# test programs took a sixth of this build's compile time.
-stage "build (ASan+UBSan)" ci/build.sh build-asan --target unit_tests -DFLATMARCH_WERROR=ON -DFLATMARCH_SANITIZE=ON \
+# test programs took a sixth of this build's compile time. Built with Clang: it compiles this
+# build in two thirds of GCC's time (scalar_f32.cpp 41 s against 76 s), its programs run the
+# tests in three quarters of GCC's (cli_errors_test 153 s against 290 s), and its warnings, as
+# errors, are a second compiler's read of the code beside GCC's in the stage above.
+stage "build (ASan+UBSan)" env CC=clang CXX=clang++ \
+  ci/build.sh build-asan --target unit_tests -DFLATMARCH_WERROR=ON -DFLATMARCH_SANITIZE=ON \
   && stage "ctest -L unit (ASan+UBSan)" run_ctest build-asan -L unit
 stage "build (fuzzers, clang)" env CC=clang CXX=clang++ ci/build.sh build-fuzz -DFLATMARCH_FUZZ=ON \
   && stage "fuzz (${fuzz_seconds}s each)" run_fuzzers
