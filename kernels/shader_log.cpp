@@ -15,12 +15,15 @@ std::string annotate_log(const std::string& source, const std::string& log, int 
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   // The lines errors name; the lines warnings name only when there is no error.
   std::set<int> named, warned;
-  // Mesa writes "0:LINE(COLUMN): error: ...", glslang "ERROR: 0:LINE: ...".
+  // Mesa writes "0:LINE(COLUMN): error: ...", NVIDIA's driver "0(LINE) : error C1503: ...",
+  // glslang "ERROR: 0:LINE: ...".
   static const std::regex kMesa(R"((?:^|\n)\s*\d+:(\d+)\(\d+\):\s*(\w+))");
+  static const std::regex kNvidia(R"((?:^|\n)\s*\d+\((\d+)\)\s*:\s*(\w+))");
   static const std::regex kGlslang(R"((?:^|\n)\s*(ERROR|WARNING):\s*\d+:(\d+):)");
-  for (auto it = std::sregex_iterator(log.begin(), log.end(), kMesa); it != std::sregex_iterator();
-       ++it)
-    ((*it)[2] == "error" ? named : warned).insert(std::stoi((*it)[1]));
+  for (const std::regex* format : {&kMesa, &kNvidia})
+    for (auto it = std::sregex_iterator(log.begin(), log.end(), *format);
+         it != std::sregex_iterator(); ++it)
+      ((*it)[2] == "error" ? named : warned).insert(std::stoi((*it)[1]));
   for (auto it = std::sregex_iterator(log.begin(), log.end(), kGlslang);
        it != std::sregex_iterator(); ++it)
     ((*it)[1] == "ERROR" ? named : warned).insert(std::stoi((*it)[2]));

@@ -16,9 +16,9 @@ class ShaderError : public std::runtime_error {
 };
 
 // The compiler's log with the lines of `source` it refers to, `context` lines either side,
-// numbered, the named line marked with `>`. It reads Mesa's "0:LINE(COLUMN): error: ..." (and
-// most drivers') and glslang's "ERROR: 0:LINE: ...". Lines that warnings name are shown only when
-// there is no error.
+// numbered, the named line marked with `>`. It reads Mesa's "0:LINE(COLUMN): error: ...",
+// NVIDIA's "0(LINE) : error C1503: ..." and glslang's "ERROR: 0:LINE: ...". Lines that warnings
+// name are shown only when there is no error.
 std::string annotate_log(const std::string& source, const std::string& log, int context = 3);
 
 }  // namespace flatmarch::kernel

@@ -82,6 +82,24 @@ TEST(OpenGlShader, CompileErrorsShowTheGeneratedLinesAround) {
   EXPECT_EQ(text.find(">    1"), std::string::npos) << "warnings are not shown with errors";
 }
 
+TEST(OpenGlShader, NvidiasCompileErrorsShowTheGeneratedLinesAround) {
+  // As NVIDIA's driver (580.159.04, an H200) wrote them for a broken call and a wrong type.
+  const std::string source = "line one\nline two\nline three\nline four\nline five\n";
+  const std::string log =
+      "0(2) : error C1503: undefined variable \"no_such_name\"\n"
+      "0(4) : error C1035: assignment of incompatible types\n"
+      "0(1) : warning C7050: \"x\" might be used before being initialized\n";
+  const std::string text = kernel::annotate_log(source, log, 0);
+  EXPECT_NE(text.find(">    2  line two"), std::string::npos) << text;
+  EXPECT_NE(text.find(">    4  line four"), std::string::npos) << text;
+  EXPECT_EQ(text.find("line three"), std::string::npos) << text;  // no context asked for
+  EXPECT_EQ(text.find(">    1"), std::string::npos) << "warnings are not shown with errors";
+  // With no error, the warnings' lines are shown.
+  EXPECT_NE(
+      kernel::annotate_log(source, "0(5) : warning C7050: unused\n", 0).find(">    5  line five"),
+      std::string::npos);
+}
+
 TEST(OpenGlShader, DriverErrorsNameTheBrokenLine) {
   SKIP_WITHOUT_OPENGL();
   const Scene& scene = test::gallery_scene("torus");
