@@ -83,7 +83,8 @@ TEST(OpenGlShader, CompileErrorsShowTheGeneratedLinesAround) {
 }
 
 TEST(OpenGlShader, NvidiasCompileErrorsShowTheGeneratedLinesAround) {
-  // As NVIDIA's driver (580.159.04, an H200) wrote them for a broken call and a wrong type.
+  // NVIDIA's format, with the two errors' texts as its driver (580.159.04, an H200) wrote them
+  // for a broken call and a wrong type; the line numbers and the warning are made up.
   const std::string source = "line one\nline two\nline three\nline four\nline five\n";
   const std::string log =
       "0(2) : error C1503: undefined variable \"no_such_name\"\n"
