@@ -1,7 +1,8 @@
 // The SIMD backend at 640x360 from each scene's own camera: rays per second and lane utilisation
 // (active lanes over lanes, summed over every pass of every packet step), per gallery scene and
 // method, on all cores with the best instruction set here, and on staircases of 4, 32 and 128
-// squares (reports/surfaces.hpp; rays run to max_distance 40), where rays spread over many rooms.
+// squares (reports/surfaces.hpp; rays run to max_distance 40), where rays spread over many rooms,
+// and of 32 and 128 squares drawn apart (staircase_apart_N: rooms that differ in coordinates).
 // For the L-shape and the double pentagon it also runs, side by side in one run, the scalar
 // backend, the SIMD backend on one thread, and every instruction set on one thread; for the cube
 // and the 32-square staircase the scalar backend: bench/speedups.py turns the JSON into the ratios
@@ -74,6 +75,10 @@ int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
   for (int squares : {4, 32, 128})  // named staircase_N
     scenes.push_back(std::make_unique<Scene>(reports::staircase_surface(squares)));
+  // The same surface with its squares drawn apart (rooms that differ in their coordinates):
+  // staircase_apart_N.
+  for (int squares : {32, 128})
+    scenes.push_back(std::make_unique<Scene>(reports::staircase_surface(squares, true)));
   const std::vector<std::string> isas = simd::isa_names(true);
   const int cores = tbb::info::default_concurrency();
   std::cerr << "simd_bench: " << cores << " cores; instruction sets here:";

@@ -72,11 +72,14 @@ Scene regular_polygon_surface(int n) {
                          "regular_polygon_surface");
 }
 
-Scene staircase_surface(int squares) {
+Scene staircase_surface(int squares, bool apart) {
   if (squares < 2 || squares > 512 || squares % 2)
     throw std::invalid_argument("staircase_surface: squares must be even, in [2, 512]");
   nlohmann::json polygons = nlohmann::json::array();
-  for (int k = 0; k < squares; ++k) polygons.push_back({{0, 0}, {2, 0}, {2, 2}, {0, 2}});
+  for (int k = 0; k < squares; ++k) {
+    const int x = apart ? 2 * k : 0;
+    polygons.push_back({{x, 0}, {x + 2, 0}, {x + 2, 2}, {x, 2}});
+  }
   nlohmann::json gluings = nlohmann::json::array();
   for (int k = 0; k < squares; ++k) {
     const int right = k % 2 == 0 ? k + 1 : k - 1;  // horizontal pairs
@@ -85,7 +88,8 @@ Scene staircase_surface(int squares) {
     gluings.push_back({{k, 2}, {up, 0}});     // top edge to the bottom edge of the one above
   }
   return scene_from_json(
-      empty_prism(polygons, gluings, Vec2(0.7, 0.9), "staircase_" + std::to_string(squares)),
+      empty_prism(polygons, gluings, Vec2(0.7, 0.9),
+                  (apart ? "staircase_apart_" : "staircase_") + std::to_string(squares)),
       "staircase_surface");
 }
 

@@ -30,8 +30,10 @@ Scene regular_polygon_surface(int n);
 
 // A staircase of `squares` (even, >= 2) squares of side 2, each its own room: right edges glue
 // square 2k to 2k+1, top edges 2k+1 to 2k+2 (cyclically), the rest follow (the classical
-// staircase square-tiled surface). Also a prism of period 2 with no objects.
-Scene staircase_surface(int squares);
+// staircase square-tiled surface). Also a prism of period 2 with no objects. Every square is
+// drawn at [0, 2]^2; `apart`: square k at [2k, 2k + 2] x [0, 2] instead, the same surface with
+// rooms that differ in their coordinates (named staircase_apart_N).
+Scene staircase_surface(int squares, bool apart = false);
 
 // The torus of side 4 as a translation prism with nothing in it: path length is max_distance.
 Scene empty_torus_prism();

@@ -113,13 +113,15 @@ TEST(Simd, EveryInstructionSetAgreesWithScalar) {
   }
 }
 
-// Rays spread over many rooms: staircases whose edges do not fit in a vector, so that a pass
-// over several rooms blends their edges by lane (32 and 128 squares: 128 and 512 edges), or
-// takes one room a pass (130 squares: 520 edges, over what the blend's tables hold). Every
-// instruction set gives the scalar frame.
+// Rays spread over many rooms: staircases whose edges do not fit in a vector. Drawn apart, a
+// pass over several rooms blends their edges by lane (32 and 128 squares: 128 and 512 edges),
+// or takes one room a pass (130 squares: 520 edges, over what the blend's tables hold); every
+// square drawn in one place, rays take whole passes reading the rooms' common edges by
+// broadcast (Walls::same_rooms). Every instruction set gives the scalar frame.
 TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
-  for (int squares : {32, 128, 130}) {
-    const Scene scene = reports::staircase_surface(squares);
+  for (const auto& [squares, apart] : std::vector<std::pair<int, bool>>{
+           {32, false}, {128, false}, {32, true}, {128, true}, {130, true}}) {
+    const Scene scene = reports::staircase_surface(squares, apart);
     for (Method m : {Method::sphere, Method::analytic}) {
       MarchParams params;
       params.method = m;
@@ -128,8 +130,7 @@ TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
       for (const std::string& isa : simd::isa_names(true)) {
         const Agreement n = compare(
             scalar, SimdBackend({.isa = isa}).render(scene, scene.camera, 64, 36, params, {}));
-        expect_identical(n,
-                         "staircase " + std::to_string(squares) + " " + to_string(m) + " " + isa);
+        expect_identical(n, scene.name + " " + to_string(m) + " " + isa);
       }
     }
   }

@@ -187,16 +187,17 @@ inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, gl
 }
 
 // Sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges each (the
-// cube, the staircases): each lane holds the numbers of its room's edges that a step reads
-// (kHeldFields), taken when a pass over several rooms first finds the lane in a room it does not
-// hold (Walls::hold), so that such a pass reads each lane's edges with a load instead of a
+// cube, the staircases drawn apart): each lane holds the numbers of its room's edges that a step
+// reads (kHeldFields), taken when a pass over several rooms first finds the lane in a room it does
+// not hold (Walls::hold), so that such a pass reads each lane's edges with a load instead of a
 // lookup or a broadcast per room blended by lane. A ray crosses once every 20-100 steps there,
 // so a lane's edges are taken far less often than they are read. With the whole passes this
 // allows (Rooms::whole), against passes of up to eight rooms blended or looked up (640x360, 2
 // cores, AVX-512, interleaved rounds): staircases of 32 and 128 squares 0.56-0.60x the time,
 // the cube 0.74x, the pillowcase 0.88x; the double pentagon's five edges 0.85-0.92x (0.80x on
 // AVX2, 0.73x on SSE4). The analytic method crosses at almost every step, and holding its edges
-// made it 1.05-1.2x slower.
+// made it 1.05-1.2x slower. Rooms alike in every number (Walls::same_rooms: a staircase whose
+// squares are drawn in one place) hold nothing: their edges are read by broadcast.
 constexpr int kHeldEdges = 5;
 constexpr std::array<Field, 6> kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
 struct HeldEdges {

@@ -125,7 +125,7 @@ class Marcher {
       // by their rooms; rays in one room take the one-room pass below.
       const int first = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), pending))];
       if (!hn::AllFalse(D(), hn::AndNot(Equal(r.polygon, first), pending))) {
-        const bool hold = !analytic && walls_.held();
+        const bool hold = !analytic && walls_.held() && !walls_.same_rooms();
         const Rooms rooms = walls_.whole_pass(r.polygon, pending, hold ? &held : nullptr);
         count_lanes(lanes, pending);
         // Three calls, so that each inlined copy knows whether it reads held edges.

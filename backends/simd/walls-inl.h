@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <vector>
 
 #include "backends/simd/lanes-inl.h"
@@ -67,6 +68,24 @@ class Walls {
       for (size_t e = 0; e < edges; ++e)
         lookup_[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], edge_extra[e]);
     }
+    // Rooms alike in every number a step reads, edge by edge (the squares of a square-tiled
+    // surface drawn in one place): a pass over several of them reads each edge's numbers by
+    // broadcast, as in one room, so that their rays take whole passes however many rooms the
+    // scene has.
+    same_rooms_ = tables.polygons.size() > 1 && most_edges_ <= kSameRoomsEdges;
+    const ivec4 first = tables.polygons.front();
+    for (const ivec4& p : tables.polygons) {
+      same_rooms_ = same_rooms_ && p.y == first.y;
+      for (size_t f = 0; f < kFields && same_rooms_; ++f)
+        for (int k = 0; k < p.y && same_rooms_; ++k)
+          same_rooms_ =
+              std::memcmp(&lookup_[f][static_cast<size_t>(p.x + k)],
+                          &lookup_[f][static_cast<size_t>(first.x + k)], sizeof(float)) == 0;
+    }
+    if (same_rooms_)
+      for (size_t f = 0; f < kFields; ++f)
+        for (int k = 0; k < first.y; ++k)
+          same_numbers_[f][static_cast<size_t>(k)] = lookup_[f][static_cast<size_t>(first.x + k)];
     if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
     std::fill_n(first_edge_.begin(), filled, 0);
@@ -146,9 +165,12 @@ class Walls {
   // pass, Rooms::whole): where they are held (held()) or looked up in vectors (glue_by_lane()).
   // Where the scene has walls, only the lookup says which edges are walls.
   bool whole(bool analytic) const {
-    if (mode_ == kTable) return true;
+    if (mode_ == kTable || (same_rooms_ && !has(kFeatureWalls))) return true;
     return !analytic && held_ && !has(kFeatureWalls);
   }
+  // Whether the rooms are alike in every number a step reads (each edge's numbers the same in
+  // every room): lanes need not hold their edges.
+  bool same_rooms() const { return same_rooms_; }
   // A whole pass over the lanes of `m` in their rooms `polygon`: each lane's edges held, taken
   // now where the lane does not hold them yet (`held` not null, held()), or its room's first
   // edge and edge count looked up (glue_by_lane()).
@@ -162,10 +184,13 @@ class Walls {
       hold(*held, polygon, m);
       rooms.first_edge = held->first_edge;
       rooms.edge_count = held->edge_count;
-    } else {
+    } else if (mode_ == kTable) {
       const VI at = Select(m, polygon, SplatI(0));
       rooms.first_edge = lookup(DI(), first_edge_, at);
       rooms.edge_count = lookup(DI(), edge_count_, at);
+    } else {  // same_rooms(): every number is read by broadcast (field)
+      rooms.first_edge = SplatI(0);
+      rooms.edge_count = SplatI(most_edges_);
     }
     return rooms;
   }
@@ -200,6 +225,7 @@ class Walls {
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
     if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
+    if (same_rooms_) return Splat(same_numbers_[f][static_cast<size_t>(at.k)]);
     if (mode_ == kTable) return lookup(D(), lookup_[f], at.edges);
     // The few rooms' numbers broadcast and blended: cheaper than a gather.
     V v = Splat(0.0f);
@@ -413,6 +439,10 @@ class Walls {
   // pentagon's 10 edges, 1.04-1.1x. In three, 4 lanes, the double pentagon was 3-7% slower than
   // kBlend (one run each, best of 2 rounds).
   static constexpr size_t kMostVectors = 2;
+  // same_rooms(), for rooms of at most kSameRoomsEdges edges, and their numbers [field][edge].
+  static constexpr int kSameRoomsEdges = 16;
+  bool same_rooms_ = false;
+  std::array<std::array<float, kSameRoomsEdges>, kFields> same_numbers_{};
   size_t vectors_ = 1;
   std::array<Table<float>, kFields> lookup_;  // [field][edge]
   // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
