@@ -72,8 +72,9 @@ class Walls {
     // surface drawn in one place): a pass over several of them reads each edge's numbers by
     // broadcast, as in one room, so that their rays take whole passes however many rooms the
     // scene has.
-    same_rooms_ = tables.polygons.size() > 1 && most_edges_ <= kSameRoomsEdges;
+    same_rooms_ = tables.polygons.size() > 1;
     const ivec4 first = tables.polygons.front();
+    same_first_edge_ = first.x;
     for (const ivec4& p : tables.polygons) {
       same_rooms_ = same_rooms_ && p.y == first.y;
       for (size_t f = 0; f < kFields && same_rooms_; ++f)
@@ -82,10 +83,6 @@ class Walls {
               std::memcmp(&lookup_[f][static_cast<size_t>(p.x + k)],
                           &lookup_[f][static_cast<size_t>(first.x + k)], sizeof(float)) == 0;
     }
-    if (same_rooms_)
-      for (size_t f = 0; f < kFields; ++f)
-        for (int k = 0; k < first.y; ++k)
-          same_numbers_[f][static_cast<size_t>(k)] = lookup_[f][static_cast<size_t>(first.x + k)];
     if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
     std::fill_n(first_edge_.begin(), filled, 0);
@@ -188,8 +185,8 @@ class Walls {
       const VI at = Select(m, polygon, SplatI(0));
       rooms.first_edge = lookup(DI(), first_edge_, at);
       rooms.edge_count = lookup(DI(), edge_count_, at);
-    } else {  // same_rooms(): every number is read by broadcast (field)
-      rooms.first_edge = SplatI(0);
+    } else {  // same_rooms(): every number is read by broadcast, the first room's (field)
+      rooms.first_edge = SplatI(same_first_edge_);
       rooms.edge_count = SplatI(most_edges_);
     }
     return rooms;
@@ -225,7 +222,7 @@ class Walls {
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
     if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
-    if (same_rooms_) return Splat(same_numbers_[f][static_cast<size_t>(at.k)]);
+    if (same_rooms_) return Splat(lookup_[f][static_cast<size_t>(same_first_edge_ + at.k)]);
     if (mode_ == kTable) return lookup(D(), lookup_[f], at.edges);
     // The few rooms' numbers broadcast and blended: cheaper than a gather.
     V v = Splat(0.0f);
@@ -439,10 +436,8 @@ class Walls {
   // pentagon's 10 edges, 1.04-1.1x. In three, 4 lanes, the double pentagon was 3-7% slower than
   // kBlend (one run each, best of 2 rounds).
   static constexpr size_t kMostVectors = 2;
-  // same_rooms(), for rooms of at most kSameRoomsEdges edges, and their numbers [field][edge].
-  static constexpr int kSameRoomsEdges = 16;
-  bool same_rooms_ = false;
-  std::array<std::array<float, kSameRoomsEdges>, kFields> same_numbers_{};
+  bool same_rooms_ = false;  // same_rooms()
+  int same_first_edge_ = 0;  // where same_rooms(), the first room's first edge, read for all
   size_t vectors_ = 1;
   std::array<Table<float>, kFields> lookup_;  // [field][edge]
   // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
