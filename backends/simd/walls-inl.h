@@ -1,9 +1,10 @@
 // The walls of a pass's rooms for packets of rays: distances to them, where rays leave by them,
 // which are opaque, and what a gluing does to the rays that cross one (march.glsl's "Walls").
 // A pass's table reads are one broadcast record per room, or, where a pass spans several rooms,
-// a load of the edges each lane holds (HeldEdges: sphere and relaxed tracing in rooms of at most
-// kHeldEdges edges), a lookup of each lane's edge in one or two vectors holding the scene's
-// edges, or, for more edges, a broadcast per room blended by lane.
+// a broadcast of numbers alike in every room, a load of the edges each lane holds (HeldEdges:
+// sphere and relaxed tracing in rooms of at most kHeldEdges edges), a lookup of each lane's edge
+// in one or two vectors holding the scene's edges, or, for more edges, a broadcast per room
+// blended by lane.
 
 // Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
 // re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
@@ -83,6 +84,23 @@ class Walls {
               std::memcmp(&lookup_[f][static_cast<size_t>(p.x + k)],
                           &lookup_[f][static_cast<size_t>(first.x + k)], sizeof(float)) == 0;
     }
+    // Numbers alike slot by slot: number f of edge k the same in every room that has an edge
+    // k (the cube's faces are translates of one square: only their corners and their lines'
+    // offsets differ). A pass over several rooms reads them by broadcast, not by lookup.
+    for (size_t f = 0; f < kFields; ++f)
+      for (int k = 0; k < std::min(most_edges_, kAlikeSlots); ++k) {
+        const float* number = nullptr;
+        bool alike = true;
+        for (const ivec4& p : tables.polygons) {
+          if (k >= p.y) continue;
+          const float* here = &lookup_[f][static_cast<size_t>(p.x + k)];
+          alike = alike && (!number || std::memcmp(here, number, sizeof(float)) == 0);
+          number = number ? number : here;
+        }
+        if (!alike || !number) continue;
+        alike_[f] |= 1u << k;
+        alike_number_[f][static_cast<size_t>(k)] = *number;
+      }
     if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
     std::fill_n(first_edge_.begin(), filled, 0);
@@ -122,6 +140,22 @@ class Walls {
       to_polygon_[e] = link.x == kEdgeGlued ? link.y : 0;
       wall_[e] = link.x == kEdgeWall ? -1 : 0;
     }
+    // A gluing's numbers alike at every glued edge (the tint, usually) are read by broadcast.
+    for (size_t f = 0; f < kGlueFields; ++f) {
+      const float* number = nullptr;
+      bool alike = true;
+      for (size_t e = 0; e < edges; ++e) {
+        if (tables.edges[e].link.x != kEdgeGlued) continue;
+        alike = alike && (!number || std::memcmp(&glue_[f][e], number, sizeof(float)) == 0);
+        number = number ? number : &glue_[f][e];
+      }
+      if (alike && number) {
+        glue_alike_ |= 1u << f;
+        glue_number_[f] = *number;
+      }
+    }
+    same_count_ = std::all_of(tables.polygons.begin(), tables.polygons.end(),
+                              [&](const ivec4& p) { return p.y == most_edges_; });
   }
 
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
@@ -184,7 +218,7 @@ class Walls {
     } else if (mode_ == kTable) {
       const VI at = Select(m, polygon, SplatI(0));
       rooms.first_edge = lookup(DI(), first_edge_, at);
-      rooms.edge_count = lookup(DI(), edge_count_, at);
+      rooms.edge_count = same_count_ ? SplatI(most_edges_) : lookup(DI(), edge_count_, at);
     } else {  // same_rooms(): every number is read by broadcast, the first room's (field)
       rooms.first_edge = SplatI(same_first_edge_);
       rooms.edge_count = SplatI(most_edges_);
@@ -223,6 +257,8 @@ class Walls {
   FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
     if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
     if (same_rooms_) return Splat(lookup_[f][static_cast<size_t>(same_first_edge_ + at.k)]);
+    if (at.k < kAlikeSlots && ((alike_[f] >> at.k) & 1u) != 0u)
+      return Splat(alike_number_[f][static_cast<size_t>(at.k)]);
     if (mode_ == kTable) return lookup(D(), lookup_[f], at.edges);
     // The few rooms' numbers broadcast and blended: cheaper than a gather.
     V v = Splat(0.0f);
@@ -371,7 +407,9 @@ class Walls {
     const DI di;
     const VI first = lookup(di, first_edge_, Select(m, r.polygon, SplatI(0)));
     const VI at = Select(m, first + edge, SplatI(0));
-    const auto glue = [&](size_t f) HWY_ATTR { return lookup(D(), glue_[f], at); };
+    const auto glue = [&](size_t f) HWY_ATTR {
+      return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
+    };
     const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
     const lane::vec4 shift{glue(0), glue(1), 0.0f, 0.0f};
     const lane::vec4 to_line{glue(6), glue(7), glue(8), 0.0f};
@@ -410,9 +448,7 @@ class Walls {
 #if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
     // AVX-512 looks up in two vectors in one instruction (Highway 1.0.3 has no
     // TwoTablesLookupLanes): the cube's analytic frames 0.93-0.94x the time of two lookups and
-    // a blend (5 interleaved rounds), the double pentagon's 0.95-0.99x. Lookups in up to eight
-    // vectors by pairs, blended (the 32-square staircase's 128 edges), made its analytic
-    // frames 1.4x slower than broadcasts blended by room (kBlend).
+    // a blend (5 interleaved rounds), the double pentagon's 0.95-0.99x.
     if constexpr (sizeof(T) == 4 && hn::MaxLanes(d) == 16) {
       const auto low = hn::LoadU(d, table.data()), high = hn::LoadU(d, table.data() + lanes);
       if constexpr (hwy::IsFloat<T>())
@@ -436,6 +472,10 @@ class Walls {
   // pentagon's 10 edges, 1.04-1.1x. In three, 4 lanes, the double pentagon was 3-7% slower than
   // kBlend (one run each, best of 2 rounds).
   static constexpr size_t kMostVectors = 2;
+  // Where number f of edge k is alike in every room, bit k of alike_[f], and the number.
+  static constexpr int kAlikeSlots = 16;
+  std::array<uint32_t, kFields> alike_{};
+  std::array<std::array<float, kAlikeSlots>, kFields> alike_number_{};
   bool same_rooms_ = false;  // same_rooms()
   int same_first_edge_ = 0;  // where same_rooms(), the first room's first edge, read for all
   size_t vectors_ = 1;
@@ -444,6 +484,9 @@ class Walls {
   // (3), its own line's normal (2) and its tint (4); and the destination polygon.
   static constexpr size_t kGlueFields = 15;
   std::array<Table<float>, kGlueFields> glue_;
+  uint32_t glue_alike_ = 0;  // bit f: number f of glue_ alike at every glued edge, glue_number_[f]
+  std::array<float, kGlueFields> glue_number_{};
+  bool same_count_ = false;  // every room has most_edges_ edges
   Table<int32_t> to_polygon_, first_edge_, edge_count_;
   Table<int32_t> wall_;  // of each edge: -1 an opaque wall, else 0
   KernelParams params_;
