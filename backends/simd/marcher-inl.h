@@ -216,15 +216,17 @@ class Marcher {
     record(m, event, r.polygon, edge, -1, -1, hit, r);
   }
 
-  // The rays of `m` at their edge `edge` (of their room) go through it or are reflected, and are
-  // placed `push` inside the edge they are then behind. One broadcast record per edge.
-  FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, VI edge, V push) const {
+  // The rays of `m` at their edge `edge` (of their room, in `rooms`) go through it or are
+  // reflected, and are placed `push` inside the edge they are then behind. One broadcast record
+  // per edge.
+  FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, const Rooms& rooms, VI edge,
+                                          V push) const {
     if (walls_.glue_by_lane() && !has(kFeatureMirrors)) {
       if (events_ && !hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1)))) {
         const ivec4 link = edges_[polygons_[hn::GetLane(r.polygon)].x + hn::GetLane(edge)].link;
         record(m, kEventGluing, r.polygon, edge, link.y, link.z, SplatI(-1), r);
       }
-      walls_.cross_glued(r, m, edge, push);
+      walls_.cross_glued(r, m, rooms.first_edge + edge, push);
       return;
     }
     std::array<int32_t, hn::MaxLanes(DI())> lane_edges{}, lane_rooms{};
@@ -350,7 +352,7 @@ class Marcher {
       hit_wall(r, walls, rooms, wall.edge, Splat(0.0f));
       const M cross = hn::AndNot(hn::Or(corner, walls), near);
       if (Any(cross)) {
-        cross_edge(r, cross, wall.edge, Splat(params_.offset));
+        cross_edge(r, cross, rooms, wall.edge, Splat(params_.offset));
         relax(x, cross);
       }
       rest = hn::AndNot(near, rest);
@@ -432,7 +434,7 @@ class Marcher {
     rest = hn::AndNot(wall, rest);
     if (Any(rest)) {
       advance(r, rest, seg.exit.s);
-      cross_edge(r, rest, seg.exit.edge, Splat(0.0f));
+      cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f));
       seg.known = hn::AndNot(rest, seg.known);
     }
   }

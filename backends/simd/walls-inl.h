@@ -399,14 +399,13 @@ class Walls {
     return {nx, ny};
   }
 
-  // The rays of `m` go through their edge `edge` (of their room, glued) into the glued room and
-  // are placed `push` inside the edge they are then behind: march.glsl's cross_edge when every
-  // edge is glued and the scene's edges fit in a vector (merge()), each lane looking its edge's
-  // gluing up (glue_), all in one round. The caller records the event.
+  // The rays of `m` go through their edge `edge` (glued; its index in the edge table) into the
+  // glued room and are placed `push` inside the edge they are then behind: march.glsl's
+  // cross_edge when every edge is glued and the scene's edges fit in a vector (merge()), each
+  // lane looking its edge's gluing up (glue_), all in one round. The caller records the event.
   FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
     const DI di;
-    const VI first = lookup(di, first_edge_, Select(m, r.polygon, SplatI(0)));
-    const VI at = Select(m, first + edge, SplatI(0));
+    const VI at = Select(m, edge, SplatI(0));
     const auto glue = [&](size_t f) HWY_ATTR {
       return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
     };
