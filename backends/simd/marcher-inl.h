@@ -52,7 +52,8 @@ class Marcher {
         events_(events),
         max_events_(max_events),
         whole_(tables.polygons.size() > 1 && solids_.by_lane() &&
-               walls_.whole(params_.method == kMethodAnalytic)) {}
+               walls_.whole(params_.method == kMethodAnalytic)),
+        one_room_(tables.polygons.size() == 1) {}
 
   // Edges held by no lane.
   static void clear(HeldEdges& held) {
@@ -117,7 +118,7 @@ class Marcher {
     const M active = hn::Not(r.done);
     r.steps = Select(active, r.steps + SplatI(1), r.steps);
     std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
-    hn::StoreU(r.polygon, DI(), lane_rooms.data());
+    if (!one_room_) hn::StoreU(r.polygon, DI(), lane_rooms.data());
     M pending = active;
     const bool analytic = params_.method == kMethodAnalytic;
     if (whole_ && Any(pending)) {
@@ -148,7 +149,15 @@ class Marcher {
       M pass = None();
       rooms.first_edge = rooms.edge_count = SplatI(0);
       const int most_rooms = walls_.merge() ? kRoomsPerPass : 1;
-      for (M left = pending; Any(left) && rooms.count < most_rooms; ++rooms.count) {
+      if (one_room_) {  // the scene's one room: no search
+        rooms.count = 1;
+        rooms.polygon[0] = 0;
+        rooms.lanes[0] = pass = pending;
+        rooms.most_edges = polygons_[0].y;
+        rooms.first_edge = SplatI(polygons_[0].x);
+        rooms.edge_count = SplatI(polygons_[0].y);
+      }
+      for (M left = pending; !one_room_ && Any(left) && rooms.count < most_rooms; ++rooms.count) {
         const int polygon = lane_rooms[static_cast<size_t>(hn::FindFirstTrue(D(), left))];
         const M in = hn::And(left, Equal(r.polygon, polygon));
         const ivec4 poly = polygons_[polygon];
@@ -485,6 +494,7 @@ class Marcher {
   // in scenes of several rooms and few solids whose edges the lanes can hold or look up
   // (Walls::whole).
   bool whole_;
+  bool one_room_;  // the scene has one room: a step's pass needs no search for rooms
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)
