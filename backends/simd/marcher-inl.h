@@ -110,8 +110,7 @@ class Marcher {
   // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
   // of the rays that have taken max_steps. Where whole_, rays over several rooms take one whole
   // pass (Rooms::whole). Otherwise a step runs in passes of up to kRoomsPerPass rooms (usually
-  // one pass); the rays a pass moves to another room are already out of `pending`. Returns the
-  // rooms its passes went over, summed (a whole pass counts two).
+  // one). Returns the rooms its passes went over, summed (a whole pass counts two).
   FLATMARCH_PACKET_INLINE int step(Packet& r, Relaxation& x, Segment& seg, HeldEdges& held,
                                    LaneCounts& lanes) const {
     int rooms_seen = 0;
@@ -138,9 +137,7 @@ class Marcher {
           sphere_step<false>(r, x, pending, rooms, nullptr);
         pending = None();
         // Counted as two rooms whatever their number: a whole pass costs the same over any
-        // number, so the packet need not wait to refill its rays together (kRefillSpread). As
-        // more than two, the cube's analytic frames were level (0.99-1.01x) with fewer lanes
-        // busy (0.874 -> 0.836), the 4-square staircase's 0.93-0.97x.
+        // number, so the packet need not wait to refill its rays together (kRefillSpread).
         rooms_seen = 2;
       }
     }
@@ -151,7 +148,6 @@ class Marcher {
       const int most_rooms = walls_.merge() ? kRoomsPerPass : 1;
       if (one_room_) {  // the scene's one room: no search
         rooms.count = 1;
-        rooms.polygon[0] = 0;
         rooms.lanes[0] = pass = pending;
         rooms.most_edges = polygons_[0].y;
         rooms.first_edge = SplatI(polygons_[0].x);
