@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "backends/simd/lanes-inl.h"
@@ -69,38 +70,34 @@ class Walls {
       for (size_t e = 0; e < edges; ++e)
         lookup_[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], edge_extra[e]);
     }
+    // Number f of edge k, where every room that has an edge k holds the same.
+    const auto alike_in_rooms = [&](size_t f, int k) {
+      return alike([&](const auto& take) {
+        for (const ivec4& p : tables.polygons)
+          if (k < p.y) take(lookup_[f][static_cast<size_t>(p.x + k)]);
+      });
+    };
     // Rooms alike in every number a step reads, edge by edge (the squares of a square-tiled
     // surface drawn in one place): a pass over several of them reads each edge's numbers by
     // broadcast, as in one room, so that their rays take whole passes however many rooms the
     // scene has.
-    same_rooms_ = tables.polygons.size() > 1;
     const ivec4 first = tables.polygons.front();
     same_first_edge_ = first.x;
-    for (const ivec4& p : tables.polygons) {
-      same_rooms_ = same_rooms_ && p.y == first.y;
-      for (size_t f = 0; f < kFields && same_rooms_; ++f)
-        for (int k = 0; k < p.y && same_rooms_; ++k)
-          same_rooms_ =
-              std::memcmp(&lookup_[f][static_cast<size_t>(p.x + k)],
-                          &lookup_[f][static_cast<size_t>(first.x + k)], sizeof(float)) == 0;
-    }
-    // Numbers alike slot by slot: number f of edge k the same in every room that has an edge
-    // k (the cube's faces are translates of one square: only their corners and their lines'
-    // offsets differ). A pass over several rooms reads them by broadcast, not by lookup.
+    same_count_ = std::all_of(tables.polygons.begin(), tables.polygons.end(),
+                              [&](const ivec4& p) { return p.y == most_edges_; });
+    same_rooms_ = tables.polygons.size() > 1 && same_count_;
+    for (size_t f = 0; f < kFields && same_rooms_; ++f)
+      for (int k = 0; k < first.y && same_rooms_; ++k)
+        same_rooms_ = alike_in_rooms(f, k).has_value();
+    // Numbers alike slot by slot, in rooms not alike in every number (the cube's faces are
+    // translates of one square: only their corners and their lines' offsets differ). A pass
+    // over several rooms reads them by broadcast, not by lookup.
     for (size_t f = 0; f < kFields; ++f)
-      for (int k = 0; k < std::min(most_edges_, kAlikeSlots); ++k) {
-        const float* number = nullptr;
-        bool alike = true;
-        for (const ivec4& p : tables.polygons) {
-          if (k >= p.y) continue;
-          const float* here = &lookup_[f][static_cast<size_t>(p.x + k)];
-          alike = alike && (!number || std::memcmp(here, number, sizeof(float)) == 0);
-          number = number ? number : here;
+      for (int k = 0; k < std::min(most_edges_, kAlikeSlots); ++k)
+        if (const std::optional<float> number = alike_in_rooms(f, k)) {
+          alike_[f] |= 1u << k;
+          alike_number_[f][static_cast<size_t>(k)] = *number;
         }
-        if (!alike || !number) continue;
-        alike_[f] |= 1u << k;
-        alike_number_[f][static_cast<size_t>(k)] = *number;
-      }
     if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
     std::fill_n(first_edge_.begin(), filled, 0);
@@ -142,20 +139,14 @@ class Walls {
     }
     // A gluing's numbers alike at every glued edge (the tint, usually) are read by broadcast.
     for (size_t f = 0; f < kGlueFields; ++f) {
-      const float* number = nullptr;
-      bool alike = true;
-      for (size_t e = 0; e < edges; ++e) {
-        if (tables.edges[e].link.x != kEdgeGlued) continue;
-        alike = alike && (!number || std::memcmp(&glue_[f][e], number, sizeof(float)) == 0);
-        number = number ? number : &glue_[f][e];
-      }
-      if (alike && number) {
-        glue_alike_ |= 1u << f;
-        glue_number_[f] = *number;
-      }
+      const std::optional<float> number = alike([&](const auto& take) {
+        for (size_t e = 0; e < edges; ++e)
+          if (tables.edges[e].link.x == kEdgeGlued) take(glue_[f][e]);
+      });
+      if (!number) continue;
+      glue_alike_ |= 1u << f;
+      glue_number_[f] = *number;
     }
-    same_count_ = std::all_of(tables.polygons.begin(), tables.polygons.end(),
-                              [&](const ivec4& p) { return p.y == most_edges_; });
   }
 
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
@@ -163,8 +154,6 @@ class Walls {
   // Whether whole passes read the edges each lane holds (HeldEdges) rather than look them up:
   // sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges.
   bool held() const { return held_; }
-  // The most edges a room of the scene has.
-  int most_edges() const { return most_edges_; }
   // Where held(): the lanes of `m` in `polygon` take their room's edges where they do not hold
   // them yet, one broadcast per number of each room taken.
   FLATMARCH_PACKET_INLINE void hold(HeldEdges& held, VI polygon, M m) const {
@@ -428,6 +417,19 @@ class Walls {
  private:
   bool has(uint feature) const { return (features_ & feature) != 0u; }
 
+  // The number every number `each` offers holds, bit for bit (each(take) calls take(x) for
+  // each x); none if they differ or there is none.
+  template <typename Each>
+  static std::optional<float> alike(const Each& each) {
+    std::optional<float> number;
+    bool same = true;
+    each([&](float x) {
+      same = same && (!number || std::memcmp(&x, &*number, sizeof(float)) == 0);
+      if (!number) number = x;
+    });
+    return same ? number : std::nullopt;
+  }
+
   const ivec4* polygons_;
   const EdgeRecord* edges_;
   const glm::vec4* extra_;  // per edge: b - a (x, y), vertex tolerance in u (z), a.y + (b - a).y
@@ -466,10 +468,7 @@ class Walls {
   enum Mode { kSingle, kTable, kBlend } mode_ = kSingle;
   bool held_ = false;  // held()
   int most_edges_ = 0;
-  // kTable's vectors a table, one or two. In two: 16 lanes, the cube's 24 edges, frames
-  // 1.2-1.25x faster than with broadcasts blended by room (kBlend); 8 lanes, the double
-  // pentagon's 10 edges, 1.04-1.1x. In three, 4 lanes, the double pentagon was 3-7% slower than
-  // kBlend (one run each, best of 2 rounds).
+  // kTable's vectors a table, one or two (in three, slower than kBlend: the README's SIMD notes).
   static constexpr size_t kMostVectors = 2;
   // Where number f of edge k is alike in every room, bit k of alike_[f], and the number.
   static constexpr int kAlikeSlots = 16;
