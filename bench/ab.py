@@ -82,7 +82,11 @@ def run_once(program, args):
         raise RuntimeError(f"{program}: no Google Benchmark JSON on its output ({e})")
     cases = {}
     for run in runs:
-        if run.get("run_type", "iteration") != "iteration" or "error_occurred" in run:
+        if run.get("run_type", "iteration") != "iteration":
+            continue
+        if run.get("error_occurred"):
+            print(f"ab.py: {program}: {run['name']} failed: {run.get('error_message', '')}",
+                  file=sys.stderr)
             continue
         cases[run["name"]] = run
     return cases
@@ -131,6 +135,9 @@ def main(argv):
             lonely.append(name)
             continue
         (a, run_a), (b, run_b) = best["base"][name], best["new"][name]
+        if a <= 0 or b <= 0:  # no time to compare (a case that measures nothing)
+            print(f"| {name} | {a:.3f} | {b:.3f} | - |{' - |' if lanes else ''} - |")
+            continue
         differ = differing_counters(run_a, run_b)
         if differ:
             different.append(name)

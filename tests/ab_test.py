@@ -102,6 +102,17 @@ def main():
     check(r.returncode == 1 and "exited with 3" in r.stderr and "stand-in failure" in r.stderr,
           f"a failing program: exit {r.returncode}, {r.stderr[-300:]}")
 
+    # A case the program reports as failed is said, and left out of the comparison.
+    erring = os.path.join(out, "erring")
+    with open(erring, "w") as f:
+        f.write("#!/usr/bin/env python3\nimport json\nprint(json.dumps(dict(benchmarks=[dict(\n"
+                "    name='a', run_type='iteration', error_occurred=True, error_message='boom',\n"
+                "    real_time=0, time_unit='ns')])))\n")
+    os.chmod(erring, os.stat(erring).st_mode | stat.S_IXUSR)
+    r = ab(ab_py, base, erring, "--rounds", "1")
+    check(r.returncode == 1 and "a failed: boom" in r.stderr and "only in base: a" in r.stdout,
+          f"a failed case: exit {r.returncode}, {r.stderr[-300:]}, {r.stdout[-300:]}")
+
     # Bad arguments: a missing program, zero rounds, a filter that matches nothing.
     r = ab(ab_py, os.path.join(out, "missing"), new)
     check(r.returncode == 2 and "not an executable file" in r.stderr,
