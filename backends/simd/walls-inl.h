@@ -284,7 +284,7 @@ class Walls {
       if (held && k >= rooms.most_edges) break;
       const Slot at = slot<kOneRoom>(rooms, k);
       const M valid = at.valid;
-      const auto read = [&](Field f) HWY_ATTR {
+      const auto read = [&](Field f) FLATMARCH_PACKET_LAMBDA {
         if (!kOneRoom && held) return held->number[static_cast<size_t>(k)][f];
         return field<kOneRoom>(at, f);
       };
@@ -395,7 +395,7 @@ class Walls {
   FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
     const DI di;
     const VI at = Select(m, edge, SplatI(0));
-    const auto glue = [&](size_t f) HWY_ATTR {
+    const auto glue = [&](size_t f) FLATMARCH_PACKET_LAMBDA {
       return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
     };
     const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
