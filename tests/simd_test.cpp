@@ -14,6 +14,7 @@
 #include <numeric>
 
 #include "backends/scalar/scalar.hpp"
+#include "backends/simd/packet.hpp"
 #include "backends/simd/simd.hpp"
 #include "reports/surfaces.hpp"
 #include "scene/load.hpp"
@@ -250,6 +251,39 @@ TEST(Simd, RoomStepsStepEveryLaneOfTheCentralPacket) {
   const simd::PacketJob job = simd::frame_job(tables, up, 64, 48, none);
   EXPECT_EQ(code.room_steps(job, 5), 0);
   EXPECT_EQ(SimdBackend().peak_lane_steps(scene, up, 64, 48, {}, 0.01), 0.0);
+}
+
+// What the packets read of a scene's edges, worked out once a frame (simd::EdgeTables). The
+// squares of a staircase drawn in one place are alike in every number; drawn apart (square k at
+// [2k, 2k + 2] x [0, 2]) only what does not depend on x is: each edge's y, its direction and
+// normal. Edge 1 of square k is glued to square k + 1 (k even), edge 2 to the square above.
+TEST(Simd, EdgeTablesFindTheNumbersAlikeInEveryRoom) {
+  for (const bool apart : {false, true}) {
+    const Scene scene = reports::staircase_surface(8, apart);
+    const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
+    const simd::EdgeTables t = simd::packet_job(tables).edges;
+    SCOPED_TRACE(scene.name);
+    EXPECT_EQ(t.most_edges, 4);
+    EXPECT_TRUE(t.same_count);
+    EXPECT_EQ(t.same_rooms, !apart);
+    EXPECT_EQ(t.same_first_edge, 0);
+    EXPECT_EQ(t.alike[simd::kAy], 0xfu);
+    EXPECT_EQ(t.alike[simd::kNx], 0xfu);
+    EXPECT_EQ(t.alike[simd::kAbx], 0xfu);
+    EXPECT_EQ(t.alike[simd::kAx], apart ? 0x0u : 0xfu);
+    const std::array<float, 4> ay{0.0f, 0.0f, 2.0f, 2.0f}, abx{2.0f, 0.0f, -2.0f, 0.0f};
+    for (size_t k = 0; k < 4; ++k) {
+      EXPECT_EQ(t.alike_number[simd::kAy][k], ay[k]) << "edge " << k;
+      EXPECT_EQ(t.alike_number[simd::kAbx][k], abx[k]) << "edge " << k;
+    }
+    // Square 2's edges: 8 to 11 in the edge table.
+    ASSERT_EQ(tables.polygons[2].x, 8);
+    EXPECT_EQ(t.number[simd::kAx][8], apart ? 4.0f : 0.0f);
+    EXPECT_EQ(t.to_polygon[9], 3);   // right: square 3
+    EXPECT_EQ(t.to_polygon[10], 1);  // top: square 1
+    EXPECT_EQ(t.to_polygon[11], 3);  // left: square 3's right edge is glued to it
+    EXPECT_EQ(std::count(t.wall.begin(), t.wall.end(), -1), 0);
+  }
 }
 
 TEST(Simd, AnUnknownInstructionSetIsUnavailableAndSaysWhy) {

@@ -13,9 +13,7 @@
 
 #include <hwy/highway.h>
 
-#include <algorithm>
 #include <array>
-#include <cstring>
 #include <vector>
 
 #include "backends/simd/lanes-inl.h"
@@ -29,20 +27,17 @@ namespace HWY_NAMESPACE {
 
 class RayEvents {
  protected:
-  RayEvents(const kernel::SceneTables<float>& tables, const std::vector<glm::vec4>& edge_extra,
-            std::vector<kernel::KernelEvent>* events, int max_events)
-      : walls_(tables, edge_extra),
-        solids_(tables),
-        polygons_(tables.polygons.data()),
-        edges_(tables.edges.data()),
-        objects_(tables.objects.data()),
-        params_(tables.params),
-        features_(tables.features),
+  RayEvents(const PacketJob& job, std::vector<kernel::KernelEvent>* events, int max_events)
+      : walls_(job),
+        solids_(*job.tables),
+        polygons_(job.tables->polygons.data()),
+        edges_(job.tables->edges.data()),
+        objects_(job.tables->objects.data()),
+        params_(job.tables->params),
+        features_(job.tables->features),
         events_(events),
         max_events_(max_events),
-        same_tint_(std::all_of(tables.edges.begin(), tables.edges.end(), [&](const EdgeRecord& e) {
-          return std::memcmp(&e.tint, &tables.edges.front().tint, sizeof(e.tint)) == 0;
-        })) {}
+        same_tint_(job.edges.same_tint) {}
 
   bool has(uint feature) const { return (features_ & feature) != 0u; }
 

@@ -1,7 +1,7 @@
 // The SIMD backend's vocabulary, per instruction set: the vector types (one lane per ray), the
 // few helpers the packet code reads as words (Splat, Select, Any), the march state of a packet
 // (march.glsl's Ray and the methods' state, one lane per ray), the rooms of a pass, and the
-// numbers of an edge the packet code reads.
+// edges a lane holds (the numbers of an edge by field are edge_tables.hpp's).
 
 // The marcher's functions are inlined into one loop, but under the sanitizers GCC then takes
 // over ten minutes on that one function: there it decides what to inline.
@@ -164,37 +164,6 @@ struct Rooms {
   bool whole = false;
   VI polygons;
 };
-
-// The numbers of an edge the packet code reads, by name.
-enum Field { kAx, kAy, kAbx, kAby, kAyAby, kNx, kNy, kNa, kInvLength2, kTolerance, kFields };
-
-inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra) {
-  switch (f) {
-    case kAx:
-      return e.segment.x;
-    case kAy:
-      return e.segment.y;
-    case kAbx:
-      return extra.x;
-    case kAby:
-      return extra.y;
-    case kAyAby:
-      return extra.w;
-    case kNx:
-      return e.line.x;
-    case kNy:
-      return e.line.y;
-    case kNa:
-      return e.line.z;
-    case kInvLength2:
-      return e.line.w;
-    case kTolerance:
-      return extra.z;
-    case kFields:
-      break;
-  }
-  return 0.0f;
-}
 
 // Sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges each (the
 // cube, the staircases drawn apart): each lane holds the numbers of its room's edges that a step

@@ -42,12 +42,11 @@ namespace HWY_NAMESPACE {
 
 class Marcher : private RayEvents {
  public:
-  Marcher(const kernel::SceneTables<float>& tables, const std::vector<glm::vec4>& edge_extra,
-          std::vector<kernel::KernelEvent>* events, int max_events)
-      : RayEvents(tables, edge_extra, events, max_events),
-        whole_(tables.polygons.size() > 1 && solids_.by_lane() &&
+  Marcher(const PacketJob& job, std::vector<kernel::KernelEvent>* events, int max_events)
+      : RayEvents(job, events, max_events),
+        whole_(job.tables->polygons.size() > 1 && solids_.by_lane() &&
                walls_.whole(params_.method == kMethodAnalytic)),
-        one_room_(tables.polygons.size() == 1) {}
+        one_room_(job.tables->polygons.size() == 1) {}
 
   // Edges held by no lane.
   static void clear(HeldEdges& held) {

@@ -158,7 +158,7 @@ class PixelQueue {
 // and a lane whose ray has ended takes a next pixel soon (kRefillAt), so that a few long rays do
 // not hold up the rest of their tile (lanes stay busy until the chunk's pixels run out).
 void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
-  const Marcher marcher(*job.tables, job.edge_extra, nullptr, 0);
+  const Marcher marcher(job, nullptr, 0);
   const DI di;
   constexpr size_t kMax = hn::MaxLanes(DI());
   const size_t n = hn::Lanes(D());
@@ -273,7 +273,7 @@ void CentralPacket(const PacketJob& job, const Marcher& marcher, Packet& r, Rela
 // lane-steps a packet takes when nothing leaves a lane idle (a ray that starts done does not
 // count).
 int64_t RoomSteps(const PacketJob& job, int64_t repeats) {
-  const Marcher marcher(*job.tables, job.edge_extra, nullptr, 0);
+  const Marcher marcher(job, nullptr, 0);
   Packet start, r;
   Relaxation start_x, x;
   Segment start_seg, seg;
@@ -298,7 +298,7 @@ int64_t RoomSteps(const PacketJob& job, int64_t repeats) {
 // its steps.
 int TraceRay(const PacketJob& job, const Ray& ray, int max_events,
              std::vector<kernel::KernelEvent>* events) {
-  const Marcher marcher(*job.tables, job.edge_extra, events, max_events);
+  const Marcher marcher(job, events, max_events);
   Packet r;
   Relaxation x;
   Segment seg;
@@ -330,6 +330,7 @@ PacketJob packet_job(const kernel::SceneTables<float>& tables) {
     job.edge_extra.emplace_back(abx, aby, tables.params.vertex_tolerance * std::sqrt(e.line.w),
                                 e.segment.y + aby);
   }
+  job.edges = edge_tables(tables, job.edge_extra);
   return job;
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "backends/backend.hpp"
+#include "backends/simd/edge_tables.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/compile.hpp"
 
@@ -22,6 +23,7 @@ struct PacketJob {
   // Per edge of tables->edges, what the packets would otherwise recompute per step: b - a (x, y),
   // the vertex tolerance in units of the edge parameter (z), a.y + (b - a).y (w).
   std::vector<glm::vec4> edge_extra;
+  EdgeTables edges;  // the edges' numbers and gluings as the packets read them
 
   // A frame: pixels [0, width) x [0, height) seen from `camera`.
   CameraBasis<float> basis{};
@@ -31,7 +33,7 @@ struct PacketJob {
   Frame* frame = nullptr;
 };
 
-// A job on `tables` with its edge_extra filled in (no frame).
+// A job on `tables` with its edge_extra and edges filled in (no frame).
 PacketJob packet_job(const kernel::SceneTables<float>& tables);
 
 // The job of a frame of `tables` seen from `camera`, drawn into `frame`: packet_job, the

@@ -19,8 +19,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cstring>
-#include <optional>
 #include <vector>
 
 #include "backends/simd/lanes-inl.h"
@@ -46,107 +44,59 @@ HWY_INLINE void Tint(Packet& r, M m, const KernelParams& params, const lane::vec
 
 class Walls {
  public:
-  Walls(const kernel::SceneTables<float>& tables, const std::vector<glm::vec4>& edge_extra)
-      : polygons_(tables.polygons.data()),
-        edges_(tables.edges.data()),
-        extra_(edge_extra.data()),
-        params_(tables.params),
-        features_(tables.features) {
+  // The scene's edges as the packets read them (packet.hpp's EdgeTables, worked out once a
+  // frame) copied into the object's arrays: as far as this instruction set's lookups load, and
+  // only room 0's numbers where the rooms are alike (the rest are never read).
+  explicit Walls(const PacketJob& job)
+      : polygons_(job.tables->polygons.data()),
+        edges_(job.tables->edges.data()),
+        extra_(job.edge_extra.data()),
+        params_(job.tables->params),
+        features_(job.tables->features) {
     // Passes over several rooms read each lane's edge from the scene's edge numbers: by a lookup
     // in up to kMostVectors vectors when the edges fit in them, else by a broadcast per room
     // blended by lane (cheaper than a gather), for scenes of up to kMostEdges edges.
+    const kernel::SceneTables<float>& tables = *job.tables;
+    const EdgeTables& t = job.edges;
     const size_t edges = tables.edges.size(), lanes = hn::Lanes(D());
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
     mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
     if (mode_ == kSingle) return;
-    for (const ivec4& p : tables.polygons) most_edges_ = std::max(most_edges_, p.y);
+    most_edges_ = t.most_edges;
     held_ = tables.params.method != kMethodAnalytic && tables.polygons.size() > 1 &&
             std::all_of(tables.polygons.begin(), tables.polygons.end(),
                         [](const ivec4& p) { return p.y <= kHeldEdges; });
+    same_first_edge_ = t.same_first_edge;
+    same_count_ = t.same_count;
+    same_rooms_ = t.same_rooms;
+    alike_ = t.alike;
+    alike_number_ = t.alike_number;
     // Zero up to whole vectors, for the lookup's loads.
     const size_t filled = std::max(edges, vectors_ * lanes);
+    const size_t from = same_rooms_ && mode_ == kBlend ? static_cast<size_t>(same_first_edge_) : 0;
+    const size_t count = same_rooms_ && mode_ == kBlend ? static_cast<size_t>(most_edges_) : edges;
     for (size_t f = 0; f < kFields; ++f) {
       std::fill_n(lookup_[f].begin(), filled, 0.0f);
-      for (size_t e = 0; e < edges; ++e)
-        lookup_[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], edge_extra[e]);
+      std::copy_n(t.number[f].begin() + static_cast<std::ptrdiff_t>(from), count,
+                  lookup_[f].begin() + static_cast<std::ptrdiff_t>(from));
     }
-    // Number f of edge k, where every room that has an edge k holds the same.
-    const auto alike_in_rooms = [&](size_t f, int k) {
-      return alike([&](const auto& take) {
-        for (const ivec4& p : tables.polygons)
-          if (k < p.y) take(lookup_[f][static_cast<size_t>(p.x + k)]);
-      });
-    };
-    // Rooms alike in every number a step reads, edge by edge (the squares of a square-tiled
-    // surface drawn in one place): a pass over several of them reads each edge's numbers by
-    // broadcast, as in one room, so that their rays take whole passes however many rooms the
-    // scene has.
-    const ivec4 first = tables.polygons.front();
-    same_first_edge_ = first.x;
-    same_count_ = std::all_of(tables.polygons.begin(), tables.polygons.end(),
-                              [&](const ivec4& p) { return p.y == most_edges_; });
-    same_rooms_ = tables.polygons.size() > 1 && same_count_;
-    for (size_t f = 0; f < kFields && same_rooms_; ++f)
-      for (int k = 0; k < first.y && same_rooms_; ++k)
-        same_rooms_ = alike_in_rooms(f, k).has_value();
-    // Numbers alike slot by slot, in rooms not alike in every number (the cube's faces are
-    // translates of one square: only their corners and their lines' offsets differ). A pass
-    // over several rooms reads them by broadcast, not by lookup.
-    for (size_t f = 0; f < kFields; ++f)
-      for (int k = 0; k < std::min(most_edges_, kAlikeSlots); ++k)
-        if (const std::optional<float> number = alike_in_rooms(f, k)) {
-          alike_[f] |= 1u << k;
-          alike_number_[f][static_cast<size_t>(k)] = *number;
-        }
     if (mode_ != kTable) return;
     // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
+    const auto copy = [&](auto& table, const auto& numbers) {
+      std::fill_n(table.begin(), filled, 0);
+      std::copy_n(numbers.begin(), edges, table.begin());
+    };
     std::fill_n(first_edge_.begin(), filled, 0);
     std::fill_n(edge_count_.begin(), filled, 0);
     for (size_t p = 0; p < tables.polygons.size(); ++p) {
       first_edge_[p] = tables.polygons[p].x;
       edge_count_[p] = tables.polygons[p].y;
     }
-    std::fill_n(wall_.begin(), filled, 0);
-    for (auto& g : glue_) std::fill_n(g.begin(), filled, 0.0f);
-    std::fill_n(to_polygon_.begin(), filled, 0);
-    for (size_t e = 0; e < edges; ++e) {
-      const EdgeRecord& edge = tables.edges[e];
-      const ivec4 link = edge.link;
-      const glm::vec4 to = link.x == kEdgeGlued
-                               ? tables
-                                     .edges[static_cast<size_t>(
-                                         tables.polygons[static_cast<size_t>(link.y)].x + link.z)]
-                                     .line
-                               : glm::vec4(0.0f);
-      const std::array<float, kGlueFields> glue{edge.map_shift.x,
-                                                edge.map_shift.y,
-                                                edge.map_linear.x,
-                                                edge.map_linear.y,
-                                                edge.map_linear.z,
-                                                edge.map_linear.w,
-                                                to.x,
-                                                to.y,
-                                                to.z,
-                                                edge.line.x,
-                                                edge.line.y,
-                                                edge.tint.x,
-                                                edge.tint.y,
-                                                edge.tint.z,
-                                                edge.tint.w};
-      for (size_t f = 0; f < kGlueFields; ++f) glue_[f][e] = glue[f];
-      to_polygon_[e] = link.x == kEdgeGlued ? link.y : 0;
-      wall_[e] = link.x == kEdgeWall ? -1 : 0;
-    }
-    // A gluing's numbers alike at every glued edge (the tint, usually) are read by broadcast.
-    for (size_t f = 0; f < kGlueFields; ++f) {
-      const std::optional<float> number = alike([&](const auto& take) {
-        for (size_t e = 0; e < edges; ++e)
-          if (tables.edges[e].link.x == kEdgeGlued) take(glue_[f][e]);
-      });
-      if (!number) continue;
-      glue_alike_ |= 1u << f;
-      glue_number_[f] = *number;
-    }
+    copy(wall_, t.wall);
+    copy(to_polygon_, t.to_polygon);
+    for (size_t f = 0; f < kGlueFields; ++f) copy(glue_[f], t.glue[f]);
+    glue_alike_ = t.glue_alike;
+    glue_number_ = t.glue_number;
   }
 
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
@@ -417,19 +367,6 @@ class Walls {
  private:
   bool has(uint feature) const { return (features_ & feature) != 0u; }
 
-  // The number every number `each` offers holds, bit for bit (each(take) calls take(x) for
-  // each x); none if they differ or there is none.
-  template <typename Each>
-  static std::optional<float> alike(const Each& each) {
-    std::optional<float> number;
-    bool same = true;
-    each([&](float x) {
-      same = same && (!number || std::memcmp(&x, &*number, sizeof(float)) == 0);
-      if (!number) number = x;
-    });
-    return same ? number : std::nullopt;
-  }
-
   const ivec4* polygons_;
   const EdgeRecord* edges_;
   const glm::vec4* extra_;  // per edge: b - a (x, y), vertex tolerance in u (z), a.y + (b - a).y
@@ -471,16 +408,13 @@ class Walls {
   // kTable's vectors a table, one or two (in three, slower than kBlend: the README's SIMD notes).
   static constexpr size_t kMostVectors = 2;
   // Where number f of edge k is alike in every room, bit k of alike_[f], and the number.
-  static constexpr int kAlikeSlots = 16;
   std::array<uint32_t, kFields> alike_{};
   std::array<std::array<float, kAlikeSlots>, kFields> alike_number_{};
   bool same_rooms_ = false;  // same_rooms()
   int same_first_edge_ = 0;  // where same_rooms(), the first room's first edge, read for all
   size_t vectors_ = 1;
   std::array<Table<float>, kFields> lookup_;  // [field][edge]
-  // Of each edge: its gluing map's shift (2) and linear part (4), the destination edge's line
-  // (3), its own line's normal (2) and its tint (4); and the destination polygon.
-  static constexpr size_t kGlueFields = 15;
+  // Of each edge: its gluing's numbers (kGlueFields); and the destination polygon.
   std::array<Table<float>, kGlueFields> glue_;
   uint32_t glue_alike_ = 0;  // bit f: number f of glue_ alike at every glued edge, glue_number_[f]
   std::array<float, kGlueFields> glue_number_{};

@@ -1,0 +1,107 @@
+#include "backends/simd/edge_tables.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <optional>
+
+namespace flatmarch::simd {
+namespace {
+
+using kernel::ivec4;
+using EdgeRecord = kernel::Tables<float>::EdgeRecord;
+
+// The number every number `each` offers holds, bit for bit (each(take) calls take(x) for each
+// x); none if they differ or there is none.
+template <typename Each>
+std::optional<float> alike(const Each& each) {
+  std::optional<float> number;
+  bool same = true;
+  each([&](float x) {
+    same = same && (!number || std::memcmp(&x, &*number, sizeof(float)) == 0);
+    if (!number) number = x;
+  });
+  return same ? number : std::nullopt;
+}
+
+}  // namespace
+
+EdgeTables edge_tables(const kernel::SceneTables<float>& tables,
+                       const std::vector<glm::vec4>& extra) {
+  EdgeTables t;
+  const size_t edges = tables.edges.size();
+  for (size_t f = 0; f < kFields; ++f) {
+    t.number[f].resize(edges);
+    for (size_t e = 0; e < edges; ++e)
+      t.number[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], extra[e]);
+  }
+  for (const ivec4& p : tables.polygons) t.most_edges = std::max(t.most_edges, p.y);
+  // Number f of edge k, where every room that has an edge k holds the same.
+  const auto alike_in_rooms = [&](size_t f, int k) {
+    return alike([&](const auto& take) {
+      for (const ivec4& p : tables.polygons)
+        if (k < p.y) take(t.number[f][static_cast<size_t>(p.x + k)]);
+    });
+  };
+  if (!tables.polygons.empty()) {
+    const ivec4 first = tables.polygons.front();
+    t.same_first_edge = first.x;
+    t.same_count = std::all_of(tables.polygons.begin(), tables.polygons.end(),
+                               [&](const ivec4& p) { return p.y == t.most_edges; });
+    t.same_rooms = tables.polygons.size() > 1 && t.same_count;
+    for (size_t f = 0; f < kFields && t.same_rooms; ++f)
+      for (int k = 0; k < first.y && t.same_rooms; ++k)
+        t.same_rooms = alike_in_rooms(f, k).has_value();
+  }
+  for (size_t f = 0; f < kFields; ++f)
+    for (int k = 0; k < std::min(t.most_edges, kAlikeSlots); ++k)
+      if (const std::optional<float> number = alike_in_rooms(f, k)) {
+        t.alike[f] |= 1u << k;
+        t.alike_number[f][static_cast<size_t>(k)] = *number;
+      }
+  for (auto& g : t.glue) g.assign(edges, 0.0f);
+  t.to_polygon.assign(edges, 0);
+  t.wall.assign(edges, 0);
+  for (size_t e = 0; e < edges; ++e) {
+    const EdgeRecord& edge = tables.edges[e];
+    const ivec4 link = edge.link;
+    const bool glued = link.x == kEdgeGlued;
+    glm::vec4 to(0.0f);  // the line of the edge it is glued to: edge link.z of room link.y
+    if (glued) {
+      const int to_edge = tables.polygons[static_cast<size_t>(link.y)].x + link.z;
+      to = tables.edges[static_cast<size_t>(to_edge)].line;
+    }
+    const std::array<float, kGlueFields> glue{edge.map_shift.x,
+                                              edge.map_shift.y,
+                                              edge.map_linear.x,
+                                              edge.map_linear.y,
+                                              edge.map_linear.z,
+                                              edge.map_linear.w,
+                                              to.x,
+                                              to.y,
+                                              to.z,
+                                              edge.line.x,
+                                              edge.line.y,
+                                              edge.tint.x,
+                                              edge.tint.y,
+                                              edge.tint.z,
+                                              edge.tint.w};
+    for (size_t f = 0; f < kGlueFields; ++f) t.glue[f][e] = glue[f];
+    t.to_polygon[e] = glued ? link.y : 0;
+    t.wall[e] = link.x == kEdgeWall ? -1 : 0;
+    t.same_tint =
+        t.same_tint && std::memcmp(&edge.tint, &tables.edges.front().tint, sizeof(edge.tint)) == 0;
+  }
+  // A gluing's numbers alike at every glued edge (the tint, usually) are read by broadcast.
+  for (size_t f = 0; f < kGlueFields; ++f) {
+    const std::optional<float> number = alike([&](const auto& take) {
+      for (size_t e = 0; e < edges; ++e)
+        if (tables.edges[e].link.x == kEdgeGlued) take(t.glue[f][e]);
+    });
+    if (!number) continue;
+    t.glue_alike |= 1u << f;
+    t.glue_number[f] = *number;
+  }
+  return t;
+}
+
+}  // namespace flatmarch::simd
