@@ -192,8 +192,13 @@ TEST(Simd, WholePassesLookingEdgesUpAgreeWithScalar) {
 // A trace follows lane 0 of a packet: the same events as the scalar kernel's, in the same
 // places, for rays through a few pixels of every scene.
 TEST(Simd, TracesMatchScalar) {
-  for (const std::string& name : test::gallery_names()) {
-    const Scene& scene = test::gallery_scene(name);
+  // The gallery, and a staircase of 32 squares drawn in one place, whose crossings read their
+  // gluings by slot (EdgeTables::glue_by_slot) on AVX-512.
+  std::vector<std::string> names = test::gallery_names();
+  names.emplace_back("staircase_32");
+  const Scene staircase = reports::staircase_surface(32, false);
+  for (const std::string& name : names) {
+    const Scene& scene = name == "staircase_32" ? staircase : test::gallery_scene(name);
     const Camera& c = scene.camera;
     const CameraBasis<double> basis = camera_basis<double>(c.yaw_deg, c.pitch_deg, c.fov_deg, 8, 5);
     for (Method m : kKernelMethods) {
@@ -283,6 +288,19 @@ TEST(Simd, EdgeTablesFindTheNumbersAlikeInEveryRoom) {
     EXPECT_EQ(t.to_polygon[10], 1);  // top: square 1
     EXPECT_EQ(t.to_polygon[11], 3);  // left: square 3's right edge is glued to it
     EXPECT_EQ(std::count(t.wall.begin(), t.wall.end(), -1), 0);
+    // Drawn in one place, every square's right edge is glued by the same translation, (-2, 0)
+    // (glue fields 0 and 1: the map's shift): a crossing reads it by slot, and its room and
+    // tint's number (the 8 squares' 16 gluings take the palette's 10 colours in turn) by one
+    // gather.
+    EXPECT_EQ(t.glue_by_slot, !apart);
+    if (apart) continue;
+    EXPECT_EQ(t.slot_glue[0][1], -2.0f);
+    EXPECT_EQ(t.slot_glue[1][1], 0.0f);
+    EXPECT_EQ(t.slot_glue[1][2], -2.0f);
+    EXPECT_EQ(t.tints.size(), 10u);
+    EXPECT_EQ(t.slot_code[9] & 0xffff, 3);  // square 2, edge 1: square 3
+    EXPECT_EQ(t.slot_code[10] & 0xffff, 1);
+    EXPECT_EQ(t.tints[static_cast<size_t>(t.slot_code[9] >> 16)], tables.edges[9].tint);
   }
 }
 

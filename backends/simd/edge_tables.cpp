@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <optional>
+#include <utility>
 
 namespace flatmarch::simd {
 namespace {
@@ -21,6 +22,41 @@ std::optional<float> alike(const Each& each) {
     if (!number) number = x;
   });
   return same ? number : std::nullopt;
+}
+
+// EdgeTables::glue_by_slot and what it reads, where the scene allows.
+void slot_gluings(const kernel::SceneTables<float>& tables, EdgeTables& t) {
+  const auto glued = [](const EdgeRecord& e) { return e.link.x == kEdgeGlued; };
+  if (tables.polygons.empty() || !t.same_count || t.most_edges > kAlikeSlots ||
+      tables.polygons.size() >= (size_t{1} << 16) ||
+      !std::all_of(tables.edges.begin(), tables.edges.end(), glued))
+    return;
+  for (size_t f = 0; f < kSlotGlueFields; ++f)
+    for (int k = 0; k < t.most_edges; ++k) {
+      const std::optional<float> number = alike([&](const auto& take) {
+        for (const ivec4& p : tables.polygons) take(t.glue[f][static_cast<size_t>(p.x + k)]);
+      });
+      if (!number) return;
+      t.slot_glue[f][static_cast<size_t>(k)] = *number;
+    }
+  std::vector<glm::vec4> tints;
+  std::vector<int32_t> code;
+  for (const ivec4& p : tables.polygons)
+    for (int k = 0; k < p.y; ++k) {
+      const EdgeRecord& e = tables.edges[static_cast<size_t>(p.x + k)];
+      const auto same = [&](const glm::vec4& c) {
+        return std::memcmp(&c, &e.tint, sizeof(c)) == 0;
+      };
+      auto tint = std::find_if(tints.begin(), tints.end(), same);
+      if (tint == tints.end()) {
+        if (tints.size() == kAlikeSlots) return;
+        tint = tints.insert(tints.end(), e.tint);
+      }
+      code.push_back(e.link.y | static_cast<int32_t>(tint - tints.begin()) << 16);
+    }
+  t.glue_by_slot = true;
+  t.slot_code = std::move(code);
+  t.tints = std::move(tints);
 }
 
 }  // namespace
@@ -101,6 +137,7 @@ EdgeTables edge_tables(const kernel::SceneTables<float>& tables,
     t.glue_alike |= 1u << f;
     t.glue_number[f] = *number;
   }
+  slot_gluings(tables, t);
   return t;
 }
 

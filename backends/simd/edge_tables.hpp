@@ -52,6 +52,8 @@ constexpr int kAlikeSlots = 16;
 // The numbers of a gluing a crossing reads: its map's shift (2) and linear part (4), the
 // destination edge's line (3), its own line's normal (2) and its tint (4).
 constexpr size_t kGlueFields = 15;
+// The first kSlotGlueFields of them, all but the tint.
+constexpr size_t kSlotGlueFields = 11;
 
 struct EdgeTables {
   std::array<std::vector<float>, kFields> number;  // [field][edge]
@@ -72,6 +74,16 @@ struct EdgeTables {
   std::vector<int32_t> to_polygon;  // of each edge: the room it is glued to, else 0
   std::vector<int32_t> wall;        // of each edge: -1 an opaque wall, else 0
   bool same_tint = true;            // every edge, glued or not, has the same tint
+  // Gluings alike slot by slot: every room has most_edges edges (at most kAlikeSlots), all
+  // glued, and edge k of every room is glued by the same numbers (glue fields below
+  // kSlotGlueFields: the map, the destination edge's line, the edge's normal), as on a
+  // square-tiled surface drawn in one place; the scene has at most kAlikeSlots tints. A crossing
+  // then reads those numbers by the lane's slot, and its destination room and tint by one gather
+  // of slot_code.
+  bool glue_by_slot = false;
+  std::array<std::array<float, kAlikeSlots>, kSlotGlueFields> slot_glue{};  // [field][slot]
+  std::vector<int32_t> slot_code;  // [room * most_edges + slot]: destination room | tint << 16
+  std::vector<glm::vec4> tints;    // the tints slot_code numbers
 };
 
 // The edge tables of `tables`, whose edges' edge_extra is `extra`.

@@ -74,12 +74,16 @@ class RayEvents {
   // per edge.
   FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, const Rooms& rooms, VI edge,
                                           V push) const {
-    if (walls_.glue_by_lane() && !has(kFeatureMirrors)) {
+    const bool by_lane = walls_.glue_by_lane() && !has(kFeatureMirrors);
+    if (by_lane || walls_.glue_by_slot()) {
       if (events_ && !hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1)))) {
         const ivec4 link = edges_[polygons_[hn::GetLane(r.polygon)].x + hn::GetLane(edge)].link;
         record(m, kEventGluing, r.polygon, edge, link.y, link.z, SplatI(-1), r);
       }
-      walls_.cross_glued(r, m, rooms.first_edge + edge, push);
+      if (by_lane)
+        walls_.cross_glued(r, m, rooms.first_edge + edge, push);
+      else
+        walls_.cross_by_slot(r, m, edge, push);
       return;
     }
     std::array<int32_t, hn::MaxLanes(DI())> lane_edges{}, lane_rooms{};

@@ -61,6 +61,15 @@ class Walls {
     const size_t edges = tables.edges.size(), lanes = hn::Lanes(D());
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
     mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
+    glue_by_slot_ = mode_ != kTable && t.glue_by_slot &&
+                    static_cast<size_t>(t.most_edges) <= lanes && t.tints.size() <= lanes;
+    if (glue_by_slot_) {
+      slot_glue_ = t.slot_glue;
+      for (size_t c = 0; c < 4; ++c)
+        for (size_t k = 0; k < t.tints.size(); ++k) slot_tint_[c][k] = t.tints[k][static_cast<int>(c)];
+      slot_code_ = t.slot_code.data();
+      slot_count_ = t.most_edges;
+    }
     if (mode_ == kSingle) return;
     most_edges_ = t.most_edges;
     held_ = tables.params.method != kMethodAnalytic && tables.polygons.size() > 1 &&
@@ -71,27 +80,29 @@ class Walls {
     same_rooms_ = t.same_rooms;
     alike_ = t.alike;
     alike_number_ = t.alike_number;
+    if (mode_ == kBlend) {  // broadcasts of the edges' numbers: no zeros needed past them
+      const size_t from = same_rooms_ ? static_cast<size_t>(same_first_edge_) : 0;
+      const size_t count = same_rooms_ ? static_cast<size_t>(most_edges_) : edges;
+      for (size_t f = 0; f < kFields; ++f)
+        std::copy_n(t.number[f].begin() + static_cast<std::ptrdiff_t>(from), count,
+                    lookup_[f].begin() + static_cast<std::ptrdiff_t>(from));
+      return;
+    }
     // Zero up to whole vectors, for the lookup's loads.
     const size_t filled = std::max(edges, vectors_ * lanes);
-    const size_t from = same_rooms_ && mode_ == kBlend ? static_cast<size_t>(same_first_edge_) : 0;
-    const size_t count = same_rooms_ && mode_ == kBlend ? static_cast<size_t>(most_edges_) : edges;
-    for (size_t f = 0; f < kFields; ++f) {
-      std::fill_n(lookup_[f].begin(), filled, 0.0f);
-      std::copy_n(t.number[f].begin() + static_cast<std::ptrdiff_t>(from), count,
-                  lookup_[f].begin() + static_cast<std::ptrdiff_t>(from));
-    }
-    if (mode_ != kTable) return;
-    // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
     const auto copy = [&](auto& table, const auto& numbers) {
       std::fill_n(table.begin(), filled, 0);
       std::copy_n(numbers.begin(), edges, table.begin());
     };
+    for (size_t f = 0; f < kFields; ++f) copy(lookup_[f], t.number[f]);
+    // Each room's edges, for whole passes (whole_pass).
     std::fill_n(first_edge_.begin(), filled, 0);
     std::fill_n(edge_count_.begin(), filled, 0);
     for (size_t p = 0; p < tables.polygons.size(); ++p) {
       first_edge_[p] = tables.polygons[p].x;
       edge_count_[p] = tables.polygons[p].y;
     }
+    // What a gluing does to the rays at each edge, for crossings in one round (cross_glued).
     copy(wall_, t.wall);
     copy(to_polygon_, t.to_polygon);
     for (size_t f = 0; f < kGlueFields; ++f) copy(glue_[f], t.glue[f]);
@@ -343,29 +354,58 @@ class Walls {
   // cross_edge when every edge is glued and the scene's edges fit in a vector (merge()), each
   // lane looking its edge's gluing up (glue_), all in one round. The caller records the event.
   FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
-    const DI di;
     const VI at = Select(m, edge, SplatI(0));
     const auto glue = [&](size_t f) FLATMARCH_PACKET_LAMBDA {
       return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
     };
+    const lane::vec4 tint{glue(11), glue(12), glue(13), glue(14)};
+    glue_rays(r, m, glue, tint, lookup(DI(), to_polygon_, at), push);
+  }
+
+  // Whether crossings read each lane's gluing by its slot (EdgeTables::glue_by_slot), in scenes
+  // whose edges do not fit in vectors: a lookup in a vector for the gluing, one gather for the
+  // destination room and the tint's number, instead of a round per room and edge crossed.
+  bool glue_by_slot() const { return glue_by_slot_; }
+  // The rays of `m` go through their edge `edge` (glued; its slot in their room), as
+  // cross_glued.
+  FLATMARCH_PACKET_INLINE void cross_by_slot(Packet& r, M m, VI edge, V push) const {
+    const DI di;
+    const VI slot = Select(m, edge, SplatI(0));
+    const auto by_slot = hn::IndicesFromVec(D(), slot);
+    const auto glue = [&](size_t f) FLATMARCH_PACKET_LAMBDA {
+      return hn::TableLookupLanes(hn::LoadU(D(), slot_glue_[f].data()), by_slot);
+    };
+    const VI at = Select(m, r.polygon * SplatI(slot_count_) + slot, SplatI(0));
+    const VI code = hn::GatherIndex(di, slot_code_, at);
+    const auto by_tint = hn::IndicesFromVec(D(), hn::ShiftRight<16>(code));
+    const auto tint = [&](size_t c) FLATMARCH_PACKET_LAMBDA {
+      return hn::TableLookupLanes(hn::LoadU(D(), slot_tint_[c].data()), by_tint);
+    };
+    glue_rays(r, m, glue, lane::vec4{tint(0), tint(1), tint(2), tint(3)},
+              hn::And(code, SplatI(0xffff)), push);
+  }
+
+ private:
+  bool has(uint feature) const { return (features_ & feature) != 0u; }
+
+  // March.glsl's cross_edge for the glued edges of `m`: `glue(f)` gives each lane's glue field
+  // f (EdgeTables), `tint` its edge's tint, `to` the room it enters.
+  template <typename Glue>
+  FLATMARCH_PACKET_INLINE void glue_rays(Packet& r, M m, const Glue& glue, const lane::vec4& tint,
+                                         VI to, V push) const {
     const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
     const lane::vec4 shift{glue(0), glue(1), 0.0f, 0.0f};
     const lane::vec4 to_line{glue(6), glue(7), glue(8), 0.0f};
-    Tint(r, m, params_, lane::vec4{glue(11), glue(12), glue(13), glue(14)},
-         lane::dot(lane::vec2(r.dx, r.dy), lane::vec2(glue(9), glue(10))));
+    Tint(r, m, params_, tint, lane::dot(lane::vec2(r.dx, r.dy), lane::vec2(glue(9), glue(10))));
     const lane::vec2 p =
         lane::place(lane::glue_point(linear, shift, lane::vec2(r.ox, r.oy)), to_line, push);
     const lane::vec2 dh = lane::glue_direction(linear, lane::vec2(r.dx, r.dy));
     V px = p.x.v, py = p.y.v, hx = dh.x.v, hy = dh.y.v, hz = r.dz;
     if (has(kFeatureScaled)) Normalize(hx, hy, hz);
-    const VI to = lookup(di, to_polygon_, at);
     r.polygon = Select(m, to, r.polygon);
     MoveTo(r, m, px, py, hx, hy, hz);
     r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
   }
-
- private:
-  bool has(uint feature) const { return (features_ & feature) != 0u; }
 
   const ivec4* polygons_;
   const EdgeRecord* edges_;
@@ -421,6 +461,13 @@ class Walls {
   bool same_count_ = false;  // every room has most_edges_ edges
   Table<int32_t> to_polygon_, first_edge_, edge_count_;
   Table<int32_t> wall_;  // of each edge: -1 an opaque wall, else 0
+  // glue_by_slot(): the gluings' numbers by slot, the tints by number (rgba), and each room's
+  // slots' destination and tint number (EdgeTables::slot_code, the job's), its rooms' edges.
+  bool glue_by_slot_ = false;
+  std::array<std::array<float, kAlikeSlots>, kSlotGlueFields> slot_glue_{};
+  std::array<std::array<float, kAlikeSlots>, 4> slot_tint_{};
+  const int32_t* slot_code_ = nullptr;
+  int slot_count_ = 0;
   KernelParams params_;
   uint features_;
 };
