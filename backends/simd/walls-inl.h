@@ -66,7 +66,8 @@ class Walls {
     if (glue_by_slot_) {
       slot_glue_ = t.slot_glue;
       for (size_t c = 0; c < 4; ++c)
-        for (size_t k = 0; k < t.tints.size(); ++k) slot_tint_[c][k] = t.tints[k][static_cast<int>(c)];
+        for (size_t k = 0; k < t.tints.size(); ++k)
+          slot_tint_[c][k] = t.tints[k][static_cast<int>(c)];
       slot_code_ = t.slot_code.data();
       slot_count_ = t.most_edges;
     }
