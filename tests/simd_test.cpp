@@ -118,10 +118,11 @@ TEST(Simd, EveryInstructionSetAgreesWithScalar) {
 // pass over several rooms blends their edges by lane (32 and 128 squares: 128 and 512 edges),
 // or takes one room a pass (130 squares: 520 edges, over what the blend's tables hold); every
 // square drawn in one place, rays take whole passes reading the rooms' common edges by
-// broadcast (Walls::same_rooms). Every instruction set gives the scalar frame.
+// broadcast (Walls::same_rooms), and cross by slot on AVX-512 (EdgeTables::glue_by_slot; at
+// 130 squares in passes of one room). Every instruction set gives the scalar frame.
 TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
   for (const auto& [squares, apart] : std::vector<std::pair<int, bool>>{
-           {32, false}, {128, false}, {32, true}, {128, true}, {130, true}}) {
+           {32, false}, {128, false}, {130, false}, {32, true}, {128, true}, {130, true}}) {
     const Scene scene = reports::staircase_surface(squares, apart);
     for (Method m : {Method::sphere, Method::analytic}) {
       MarchParams params;
