@@ -62,7 +62,8 @@ class Walls {
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
     mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
     glue_by_slot_ = mode_ != kTable && t.glue_by_slot &&
-                    static_cast<size_t>(t.most_edges) <= lanes && t.tints.size() <= lanes;
+                    static_cast<size_t>(t.most_edges) <= lanes && t.tints.size() <= 2 * lanes;
+    two_tint_vectors_ = t.tints.size() > lanes;
     if (glue_by_slot_) {
       slot_glue_ = t.slot_glue;
       for (size_t c = 0; c < 4; ++c)
@@ -378,9 +379,18 @@ class Walls {
     };
     const VI at = Select(m, r.polygon * SplatI(slot_count_) + slot, SplatI(0));
     const VI code = hn::GatherIndex(di, slot_code_, at);
-    const auto by_tint = hn::IndicesFromVec(D(), hn::ShiftRight<16>(code));
+    // The tints in one vector, or two (AVX2: the staircases' ten on 8 lanes; AVX-512's 16
+    // lanes hold every tint glue_by_slot allows).
+    const VI number = hn::ShiftRight<16>(code);
     const auto tint = [&](size_t c) FLATMARCH_PACKET_LAMBDA {
-      return hn::TableLookupLanes(hn::LoadU(D(), slot_tint_[c].data()), by_tint);
+      const float* table = slot_tint_[c].data();
+      if (hn::MaxLanes(D()) >= kAlikeSlots || !two_tint_vectors_)
+        return hn::TableLookupLanes(hn::LoadU(D(), table), hn::IndicesFromVec(D(), number));
+      const int lanes = static_cast<int>(hn::Lanes(D()));
+      const auto low = hn::IndicesFromVec(D(), hn::And(number, SplatI(lanes - 1)));
+      const M upper = hn::RebindMask(D(), number > SplatI(lanes - 1));
+      return Select(upper, hn::TableLookupLanes(hn::LoadU(D(), table + lanes), low),
+                    hn::TableLookupLanes(hn::LoadU(D(), table), low));
     };
     glue_rays(r, m, glue, lane::vec4{tint(0), tint(1), tint(2), tint(3)},
               hn::And(code, SplatI(0xffff)), push);
@@ -465,6 +475,7 @@ class Walls {
   // glue_by_slot(): the gluings' numbers by slot, the tints by number (rgba), and each room's
   // slots' destination and tint number (EdgeTables::slot_code, the job's), its rooms' edges.
   bool glue_by_slot_ = false;
+  bool two_tint_vectors_ = false;  // more tints than lanes
   std::array<std::array<float, kAlikeSlots>, kSlotGlueFields> slot_glue_{};
   std::array<std::array<float, kAlikeSlots>, 4> slot_tint_{};
   const int32_t* slot_code_ = nullptr;
