@@ -118,8 +118,8 @@ TEST(Simd, EveryInstructionSetAgreesWithScalar) {
 // pass over several rooms blends their edges by lane (32 and 128 squares: 128 and 512 edges),
 // or takes one room a pass (130 squares: 520 edges, over what the blend's tables hold); every
 // square drawn in one place, rays take whole passes reading the rooms' common edges by
-// broadcast (Walls::same_rooms), and cross by slot on AVX-512 (EdgeTables::glue_by_slot; at
-// 130 squares in passes of one room). Every instruction set gives the scalar frame.
+// broadcast (Walls::same_rooms), and cross by slot on AVX-512 and AVX2 (EdgeTables::glue_by_slot;
+// at 130 squares in passes of one room). Every instruction set gives the scalar frame.
 TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
   for (const auto& [squares, apart] : std::vector<std::pair<int, bool>>{
            {32, false}, {128, false}, {130, false}, {32, true}, {128, true}, {130, true}}) {
@@ -194,7 +194,7 @@ TEST(Simd, WholePassesLookingEdgesUpAgreeWithScalar) {
 // places, for rays through a few pixels of every scene.
 TEST(Simd, TracesMatchScalar) {
   // The gallery, and a staircase of 32 squares drawn in one place, whose crossings read their
-  // gluings by slot (EdgeTables::glue_by_slot) on AVX-512.
+  // gluings by slot (EdgeTables::glue_by_slot) on AVX-512 and AVX2.
   std::vector<std::string> names = test::gallery_names();
   names.emplace_back("staircase_32");
   const Scene staircase = reports::staircase_surface(32, false);
