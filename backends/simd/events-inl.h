@@ -70,8 +70,9 @@ class RayEvents {
   }
 
   // The rays of `m` at their edge `edge` (of their room, in `rooms`) go through it or are
-  // reflected, and are placed `push` inside the edge they are then behind. One broadcast record
-  // per edge.
+  // reflected, and are placed `push` inside the edge they are then behind. In one round where
+  // each lane's gluing can be looked up (by its edge, Walls::cross_glued; by its slot,
+  // Walls::cross_by_slot); else one broadcast record per edge crossed.
   FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, const Rooms& rooms, VI edge,
                                           V push) const {
     const bool by_lane = walls_.glue_by_lane() && !has(kFeatureMirrors);

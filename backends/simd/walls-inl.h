@@ -44,7 +44,7 @@ HWY_INLINE void Tint(Packet& r, M m, const KernelParams& params, const lane::vec
 
 class Walls {
  public:
-  // The scene's edges as the packets read them (packet.hpp's EdgeTables, worked out once a
+  // The scene's edges as the packets read them (edge_tables.hpp's EdgeTables, worked out once a
   // frame) copied into the object's arrays: as far as this instruction set's lookups load, and
   // only room 0's numbers where the rooms are alike (the rest are never read).
   explicit Walls(const PacketJob& job)
