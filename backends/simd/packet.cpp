@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <mutex>
+#include <stdexcept>
 
 #include "backends/simd/packet.hpp"
 // Per-target parts (after foreach_target.h, as it re-includes this file for each target).
@@ -27,6 +28,27 @@ HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
 
+#if HWY_TARGET == HWY_SCALAR
+// Highway compiles its baseline target, one lane without SIMD, into every dispatch table, but the
+// backend never runs it: simd.cpp offers avx512, avx2 and sse4 (kIsas) and is unavailable on a CPU
+// without one. Compiled as the others, it was nearly half of this file's compile time (280 s ->
+// 152 s at -O2 -g on one core of a Zen 5); here the entry points only say so.
+[[noreturn]] inline void NotOffered() {
+  throw std::logic_error("the simd backend has no packets for Highway's scalar target");
+}
+int PacketLanes() {
+  NotOffered();
+}
+void MarchPackets(const PacketJob&, int, int, int, int, LaneCounts*) {
+  NotOffered();
+}
+int64_t RoomSteps(const PacketJob&, int64_t) {
+  NotOffered();
+}
+int TraceRay(const PacketJob&, const Ray&, int, std::vector<kernel::KernelEvent>*) {
+  NotOffered();
+}
+#else
 // march.glsl's shade(): the colour of finished rays, linear and tone-mapped.
 HWY_INLINE void Shade(const KernelParams& params, const Packet& r, V& red, V& green, V& blue) {
   const lane::vec3 fog(lane::Broadcast(params.fog));
@@ -313,6 +335,8 @@ int TraceRay(const PacketJob& job, const Ray& ray, int max_events,
     marcher.step(r, x, seg, held, lanes);
   return hn::GetLane(r.steps);
 }
+
+#endif  // HWY_TARGET == HWY_SCALAR
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
