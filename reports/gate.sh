@@ -17,7 +17,7 @@ cd "$root"
 # webgl is left out: Chromium compiles each of its pages' shaders for seconds on SwiftShader (3
 # minutes more on 2 cores); the web_export and gallery conformance tests hold it to the oracle.
 # Three repetitions: the timings only warn, and a case slower in all three than in all of the
-# baseline's still does (Mann-Whitney p = 0.037 against five); 118 s -> 102 s on 2 cores.
+# baseline's still does (Mann-Whitney p = 0.037 against five); alone on 2 cores 118 s -> 102 s.
 options=(report --no-sweep --no-scaling --no-html -q --size 160x90 --conform-size 160x90
          --repetitions 3 --min-time 0.01 --skip-backend webgl -o "$out")
 if ((write)); then
