@@ -5,8 +5,9 @@ Runs BASE and NEW in turn, round after round (the order swapped every other roun
 drift of the machine weighs on both), and prints per case the best time of each, NEW's time over
 BASE's, the SIMD backend's lanes busy where the program reports them, and whether the two did the
 same work: the counters that depend only on the frame (steps, crossings) must agree, or the ratio
-compares different frames. This is how the README's "A against B, best of N interleaved rounds"
-figures are measured; machines here are noisy, so only ratios from one run mean anything.
+compares different frames. This is how backends/simd/NOTES.md's "A against B, best of N
+interleaved rounds" figures are measured; machines here are noisy, so only ratios from one run
+mean anything.
 
     python3 bench/ab.py BASE NEW --filter='simd/analytic/(cube|l_shape)/avx512/' --rounds 3 --pin 0
 

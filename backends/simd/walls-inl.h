@@ -456,7 +456,7 @@ class Walls {
   enum Mode { kSingle, kTable, kBlend } mode_ = kSingle;
   bool held_ = false;  // held()
   int most_edges_ = 0;
-  // kTable's vectors a table, one or two (in three, slower than kBlend: the README's SIMD notes).
+  // kTable's vectors a table, one or two (in three, slower than kBlend: NOTES.md).
   static constexpr size_t kMostVectors = 2;
   // Where number f of edge k is alike in every room, bit k of alike_[f], and the number.
   std::array<uint32_t, kFields> alike_{};
