@@ -1,8 +1,8 @@
-// The conformance suite on the gallery: every kernel backend (scalar, simd, opengl through
-// OSMesa, vulkan on lavapipe under the validation layer) x every scene of the gallery and of
-// conformance/scenes x every method,
-// at default parameters (float32, and float64 on the scalar backend), measured against the oracle
-// and judged by conformance/thresholds.json. Labelled `conformance`. A backend that is unavailable
+// The conformance suite on the gallery: every kernel backend (scalar, simd, opengl and vulkan
+// on their default devices, here llvmpipe through EGL and lavapipe, vulkan under the validation
+// layer) x every scene of the gallery and of conformance/scenes x every method, at default
+// parameters (float32, and float64 on the scalar backend), measured against the oracle and
+// judged by conformance/thresholds.json. Labelled `conformance`. A backend that is unavailable
 // here is skipped, with the reason.
 #include <gtest/gtest.h>
 
