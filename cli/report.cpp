@@ -132,13 +132,14 @@ void add_report(CLI::App& app) {
       "the ranking of backends and recommended parameters, the recommended method's images with\n"
       "their differences from the oracle, gallery images per backend, speed against accuracy,\n"
       "the ambiguous share, stability and step heatmaps, scaling curves, definitions. The quick\n"
-      "default takes a few minutes on 2 cores; --full measures more. Given result files\n"
-      "(RESULTS...), measures nothing: one file makes its page again, several compare their\n"
-      "machines. --baseline checks the deterministic figures (steps, crossings, conformance\n"
-      "rates) against committed ones: exit 1 when one regresses beyond its tolerance; slower\n"
-      "timings only warn. Without it the page shows the same check against\n"
-      "reports/baseline.json when this run was measured as it was, else why not. --previous\n"
-      "adds the change per case since an earlier run.");
+      "default takes about five minutes on 2 cores, and ten more where the webgl backend's\n"
+      "browser draws in software (SwiftShader; --skip-backend webgl leaves it out); --full\n"
+      "measures more. Given result files (RESULTS...), measures nothing: one file makes its\n"
+      "page again, several compare their machines. --baseline checks the deterministic\n"
+      "figures (steps, crossings, conformance rates) against committed ones: exit 1 when one\n"
+      "regresses beyond its tolerance; slower timings only warn. Without it the page shows the\n"
+      "same check against reports/baseline.json when this run was measured as it was, else why\n"
+      "not. --previous adds the change per case since an earlier run.");
   struct Options {
     std::vector<std::string> results, backends, skip_backends, scenes, methods;
     std::vector<std::string> galleries = {"scenes"};
