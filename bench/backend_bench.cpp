@@ -29,6 +29,12 @@ int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Backend>> available;
   for (const std::string& name : backend_names()) {
     std::unique_ptr<Backend> b = make_backend(name, {});
+    std::vector<std::string> names;  // as Google Benchmark names them: manual time
+    for (Method method : b->methods())
+      for (const auto& scene : scenes)
+        names.push_back(reports::case_name(name, method, scene->name, width, height) +
+                        "/manual_time");
+    if (!bench::selects_any(names)) continue;  // not started for nothing
     if (const Availability a = b->availability(); !a.available)
       std::cerr << "backend_bench: the " << name
                 << " backend is unavailable here, skipped: " << a.reason << "\n";

@@ -122,6 +122,28 @@ inline bool begin(int& argc, char** argv) {
   return !benchmark::ReportUnrecognizedArguments(argc, argv);
 }
 
+// Whether --benchmark_filter selects the benchmark of this name: a regular expression searched
+// for in the name, a leading '-' negating it; none, "." and "all" select every one. Throws
+// std::regex_error where the filter is not a regular expression.
+inline bool selected(const std::string& name) {
+  std::string filter = benchmark::GetBenchmarkFilter();
+  const bool negative = !filter.empty() && filter[0] == '-';
+  if (negative) filter.erase(0, 1);
+  if (filter.empty() || filter == "." || filter == "all") return true;
+  return std::regex_search(name, std::regex(filter)) != negative;
+}
+
+// Whether the filter selects any of these names (false where it is not a regular expression:
+// run() says so). A program asks before it starts a backend whose benchmarks these are: a
+// browser or a GPU driver takes seconds to start, for nothing where none of them is run.
+inline bool selects_any(const std::vector<std::string>& names) {
+  try {
+    return std::any_of(names.begin(), names.end(), selected);
+  } catch (const std::regex_error&) {
+    return false;
+  }
+}
+
 // A name as a regular expression that matches it alone.
 inline std::string regex_escaped(const std::string& name) {
   static const std::regex special(R"([.^$|()\[\]{}*+?\\])");
@@ -140,16 +162,10 @@ inline int run() {
     benchmark::Shutdown();
     return 0;
   }
-  std::string filter = benchmark::GetBenchmarkFilter();
-  const bool negative = !filter.empty() && filter[0] == '-';
-  if (negative) filter.erase(0, 1);
-  const bool all = filter.empty() || filter == "." || filter == "all";
   std::vector<std::pair<std::string, double>> cases;
   try {
-    const std::regex selects(all ? "." : filter);
     for (size_t k = 0; k < r.names.size(); ++k)
-      if (all || std::regex_search(r.names[k], selects) != negative)
-        cases.emplace_back(r.names[k], r.costs[k]);
+      if (selected(r.names[k])) cases.emplace_back(r.names[k], r.costs[k]);
   } catch (const std::regex_error& e) {
     std::fprintf(stderr, "--benchmark_filter: not a regular expression: %s\n", e.what());
     return 2;
