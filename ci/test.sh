@@ -6,7 +6,7 @@
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-fuzz_seconds=${FLATMARCH_FUZZ_SECONDS:-60}
+fuzz_seconds=${FLATMARCH_FUZZ_SECONDS:-30}
 # Mesa's drivers keep allocations for the life of a process; see ci/lsan.supp.
 export LSAN_OPTIONS="suppressions=$root/ci/lsan.supp"
 
