@@ -206,6 +206,9 @@ TEST_P(GalleryScene, CameraShowsAnObjectAndMore) {
 // surface. Luminance: Rec. 709 weights of the sRGB values, as an image viewer shows them.
 TEST_P(GalleryScene, ReadsWellAsANewUserRendersIt) {
   const fs::path file = GetParam();
+  if (!test::in_sanitized_sample(file))
+    GTEST_SKIP() << "under the sanitizers, every " << test::kSanitizedStride
+                 << "th scene (tests/gallery.hpp)";
   const std::string png = test::make_temp_dir() + "/reads_well_" + file.stem().string() + ".png";
   const auto r = test::run_flatmarch({"render", file.string(), "-o", png, "--size", "320x180"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
