@@ -28,6 +28,13 @@ constexpr std::array<std::pair<const char*, int64_t>, 3> kIsas{
 
 }  // namespace
 
+// Made with the backend, started by its first frame (task_arena starts once, safely from any
+// thread), and shared by the threads that render with it (execute() may be called from several).
+struct Threads {
+  explicit Threads(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
+  tbb::task_arena arena;
+};
+
 PacketJob frame_job(const kernel::SceneTables<float>& tables, const Camera& camera, int width,
                     int height, Frame& frame) {
   PacketJob job = packet_job(tables);
@@ -76,6 +83,7 @@ SimdBackend::SimdBackend(BackendOptions options) : options_(std::move(options)) 
     if (isa_ == name) target_ = target;
   // The best target needs no forcing.
   if (target_ != 0) code_ = simd::packet_code(isa_ == supported.front() ? 0 : target_);
+  if (target_ != 0) threads_ = std::make_shared<simd::Threads>(options_.threads);
 }
 
 std::string SimdBackend::description() const {
@@ -134,8 +142,7 @@ Frame SimdBackend::render_counted(const Scene& scene, const Camera& camera, int 
   std::mutex progress_mutex;
   double reported = 0.0;
   const double total = static_cast<double>(rows) * cols;
-  tbb::task_arena arena(options_.threads > 0 ? options_.threads : tbb::task_arena::automatic);
-  arena.execute([&] {
+  threads_->arena.execute([&] {
     // Chunks of 2 x 8 packets (8 x 32 pixels with 16 lanes) at the smallest: enough to spread
     // a frame's variable cost over the cores, few enough that scheduling costs nothing.
     tbb::parallel_for(
