@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 #include <utility>
@@ -63,9 +64,12 @@ struct Trace {
 };
 
 // An allocator whose new elements are left uninitialised (default-initialised), for buffers
-// that are written in full before they are read.
+// that are written in full before they are read, and which start on a cache line: threads that
+// write neighbouring blocks of a frame's rows then share no line where the blocks' widths are
+// whole lines (simd::TileBlocks).
 template <typename T>
 struct UninitialisedAllocator : std::allocator<T> {
+  static constexpr std::align_val_t kAlignment{64};
   template <typename U>
   struct rebind {
     using other = UninitialisedAllocator<U>;
@@ -73,6 +77,8 @@ struct UninitialisedAllocator : std::allocator<T> {
   UninitialisedAllocator() = default;
   template <typename U>
   explicit UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+  T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlignment)); }
+  void deallocate(T* p, size_t) noexcept { ::operator delete(p, kAlignment); }
   template <typename U>
   void construct(U* p) noexcept {
     ::new (static_cast<void*>(p)) U;

@@ -1,10 +1,10 @@
 // What the packet code reads of a scene's edges, worked out once a frame (packet_job) rather than
-// by the marcher of each of oneTBB's chunks: the edges' numbers by field, which of them are alike
-// in every room or slot by slot, and what a gluing does at each edge. The per-target Walls
-// (walls-inl.h) copies what it reads into its own arrays. Built per chunk, this took 4% of a
-// 128-square staircase's analytic samples on one thread (the checks for numbers alike go over
-// every room) and halved its `peak_steps_per_s`, whose timed loop builds a marcher too.
-// Plain data, the same for every instruction set.
+// by the marcher of each of the frame's chunks (as it was): the edges' numbers by field, which of
+// them are alike in every room or slot by slot, and what a gluing does at each edge. The per-target
+// Walls (walls-inl.h) copies what it reads into its own arrays. Built per chunk, this took 4% of a
+// 128-square staircase's analytic samples on one thread (the checks for numbers alike go over every
+// room) and halved its `peak_steps_per_s`, whose timed loop builds a marcher too. Plain data, the
+// same for every instruction set.
 #pragma once
 
 #include <array>

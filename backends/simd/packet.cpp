@@ -39,7 +39,7 @@ namespace HWY_NAMESPACE {
 int PacketLanes() {
   NotOffered();
 }
-void MarchPackets(const PacketJob&, int, int, int, int, LaneCounts*) {
+void MarchPackets(const PacketJob&, TileBlocks&, int, LaneCounts*) {
   NotOffered();
 }
 int64_t RoomSteps(const PacketJob&, int64_t) {
@@ -134,27 +134,25 @@ constexpr size_t kRefillSpread = 6;
 constexpr int kRefillPatience = 16;
 constexpr int kRefillPatienceTwoRooms = 48;
 
-// The pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's grid of
-// tiles, in the order a chunk's packets take them: tile by tile, row-major; lane order within a
-// tile; pixels outside the frame skipped. A cursor, not an index: no division per pixel.
+// The pixels of the blocks of tiles a thread takes from `blocks`, in the order its packet takes
+// them: block after block as they come, tile by tile within a block, row-major; lane order within
+// a tile; pixels outside the frame skipped. A cursor, not an index: no division per pixel.
 class PixelQueue {
  public:
-  PixelQueue(const PacketJob& job, int row0, int row1, int col0, int col1, int lanes)
-      : tile_(tile_shape(lanes)),
+  PixelQueue(const PacketJob& job, TileBlocks& blocks, int part, int lanes)
+      : blocks_(blocks),
+        part_(part),
+        tile_(tile_shape(lanes)),
         lanes_(lanes),
-        col0_(col0),
-        col1_(col1),
-        row1_(row1),
         width_(job.width),
-        height_(job.height),
-        row_(row0),
-        col_(col0) {
-    if (col0 >= col1) row_ = row1;
-  }
-  bool empty() const { return row_ >= row1_; }
+        height_(job.height) {}
+  // Whether pixels may be left: the block's, or blocks not yet taken (pop() tells). A load, no
+  // call: the step's loop asks it every time round.
+  bool more() const { return row_ < row1_ || !drained_; }
   // The next pixel (i, j) in the frame; false when none is left.
   bool pop(int& i, int& j) {
-    while (!empty()) {  // bounded: every turn moves the cursor on
+    // Bounded: every turn moves the cursor on or takes one of the frame's blocks.
+    while (row_ < row1_ || next_block()) {
       i = col_ * tile_.width + lane_ % tile_.width;
       j = row_ * tile_.height + lane_ / tile_.width;
       if (++lane_ == lanes_) {
@@ -170,16 +168,31 @@ class PixelQueue {
   }
 
  private:
+  bool next_block() {
+    if (drained_ || !blocks_.take(part_, row_, row1_, col0_, col1_)) {
+      drained_ = true;  // and no more calls to take()
+      return false;
+    }
+    col_ = col0_;
+    lane_ = 0;
+    return true;
+  }
+
+  TileBlocks& blocks_;
+  int part_;
   TileShape tile_;
-  int lanes_, col0_, col1_, row1_, width_, height_;
-  int row_, col_, lane_ = 0;  // the next pixel's tile row, tile column and lane
+  int lanes_, width_, height_;
+  int row_ = 0, row1_ = 0, col0_ = 0, col1_ = 0;  // the block: its tile rows and columns
+  int col_ = 0, lane_ = 0;                        // the next pixel's tile column and lane
+  bool drained_ = false;
 };
 
-// Marches the pixels of the tiles in rows [row0, row1) and columns [col0, col1) of the frame's
-// grid of tiles and writes them. The lanes of one packet take the chunk's pixels tile by tile,
-// and a lane whose ray has ended takes a next pixel soon (kRefillAt), so that a few long rays do
-// not hold up the rest of their tile (lanes stay busy until the chunk's pixels run out).
-void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, LaneCounts* lanes) {
+// Marches the pixels of the blocks of tiles it takes from `blocks`, until none is left, and
+// writes them. The lanes of one packet take the pixels tile by tile, and a lane whose ray has
+// ended takes a next pixel soon (kRefillAt), so that a few long rays do not hold up the rest of
+// their tile; one block's pixels follow the last's in the same packet, so lanes stay busy until
+// the frame's pixels run out.
+void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
   const Marcher marcher(job, nullptr, 0);
   const DI di;
   constexpr size_t kMax = hn::MaxLanes(DI());
@@ -195,8 +208,8 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   const V from_x = Splat(job.from.x), from_y = Splat(job.from.y), from_z = Splat(job.from.z);
   Frame& frame = *job.frame;
 
-  PixelQueue queue(job, row0, row1, col0, col1, static_cast<int>(n));
-  const int64_t pixels = int64_t{row1 - row0} * (col1 - col0) * static_cast<int64_t>(n);
+  PixelQueue queue(job, blocks, part, static_cast<int>(n));
+  const int64_t pixels = blocks.tiles() * static_cast<int64_t>(n);  // at most
   Packet r;
   Relaxation x;
   Segment seg;
@@ -217,7 +230,7 @@ void MarchPackets(const PacketJob& job, int row0, int row1, int col0, int col1, 
   int waited = 0;  // steps since the last refill, counted where patience applies
   for (int64_t iteration = 0; iteration < bound; ++iteration) {
     // Lanes are refilled once enough of them wait, or when none is left marching.
-    const M waiting = !queue.empty() ? r.done : hn::And(r.done, occupied);
+    const M waiting = queue.more() ? r.done : hn::And(r.done, occupied);
     const size_t count = hn::CountTrue(D(), waiting);
     if (count > 0 && (count >= (spread ? kRefillSpread : kRefillAt) * n / 8 ||
                       hn::AllTrue(D(), r.done) || (patience > 0 && waited >= patience))) {

@@ -1,14 +1,16 @@
 #include "backends/simd/simd.hpp"
 
 #include <hwy/targets.h>
-#include <oneapi/tbb/blocked_range2d.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
@@ -118,6 +120,51 @@ void check_precision(const MarchParams& params) {
         "the simd backend marches in f32 only (the scalar backend runs f64)");
 }
 
+// Reports `done()` (a fraction below 1) to `progress` every 20 ms from a thread of its own, while
+// it rises by 2% or more, until finish(), which reports 1. Nothing, and no thread, without
+// `progress`.
+class ProgressPoller {
+ public:
+  ProgressPoller(const Progress& progress, std::function<double()> done)
+      : progress_(progress), done_(std::move(done)) {
+    if (progress_) thread_ = std::thread([this] { run(); });
+  }
+  ProgressPoller(const ProgressPoller&) = delete;
+  ProgressPoller& operator=(const ProgressPoller&) = delete;
+  ~ProgressPoller() { stop(); }
+  void finish() {
+    stop();
+    if (progress_) progress_(1.0);
+  }
+
+ private:
+  void run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    double reported = 0.0;
+    // Bounded: ends when stop() is called, once the frame is done.
+    while (!stopped_.wait_for(lock, std::chrono::milliseconds(20), [this] { return stop_; })) {
+      const double fraction = done_();
+      if (fraction - reported >= 0.02 && fraction < 1.0) progress_(reported = fraction);
+    }
+  }
+  void stop() {
+    if (!thread_.joinable()) return;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    stopped_.notify_one();
+    thread_.join();
+  }
+
+  const Progress& progress_;
+  std::function<double()> done_;
+  std::mutex mutex_;
+  std::condition_variable stopped_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
 }  // namespace
 
 Frame SimdBackend::render(const Scene& scene, const Camera& camera, int width, int height,
@@ -138,31 +185,28 @@ Frame SimdBackend::render_counted(const Scene& scene, const Camera& camera, int 
   const int rows = (height + tile.height - 1) / tile.height;
   const int cols = (width + tile.width - 1) / tile.width;
 
-  std::atomic<int64_t> active{0}, slots{0}, packets_done{0};
-  std::mutex progress_mutex;
-  double reported = 0.0;
-  const double total = static_cast<double>(rows) * cols;
+  std::atomic<int64_t> active{0}, slots{0};
+  // One packet a thread, each taking blocks of tiles until none is left (simd::TileBlocks).
+  simd::TileBlocks blocks(rows, cols, threads_->arena.max_concurrency());
+  // Progress, where asked for: the share of the frame's blocks handed out, read by a thread of
+  // its own every 20 ms (the packets' loop makes no call to report it), then 1 once every pixel
+  // is written.
+  ProgressPoller poller(progress, [&] {
+    return static_cast<double>(blocks.taken()) /
+           static_cast<double>(std::max<int64_t>(blocks.count(), 1));
+  });
   threads_->arena.execute([&] {
-    // Chunks of 2 x 8 packets (8 x 32 pixels with 16 lanes) at the smallest: enough to spread
-    // a frame's variable cost over the cores, few enough that scheduling costs nothing.
     tbb::parallel_for(
-        tbb::blocked_range2d<int>(0, rows, 2, 0, cols, 8), [&](const tbb::blocked_range2d<int>& r) {
+        0, blocks.parts(), 1,
+        [&](int part) {
           simd::LaneCounts local;
-          packets.march(job, r.rows().begin(), r.rows().end(), r.cols().begin(), r.cols().end(),
-                        &local);
+          packets.march(job, blocks, part, &local);
           active += local.active;
           slots += local.slots;
-          const int64_t done = packets_done +=
-              static_cast<int64_t>(r.rows().size()) * static_cast<int64_t>(r.cols().size());
-          if (!progress) return;
-          const std::lock_guard<std::mutex> lock(progress_mutex);
-          const double fraction = static_cast<double>(done) / total;
-          if (fraction - reported >= 0.02 || done == rows * int64_t{cols}) {
-            reported = fraction;
-            progress(fraction);
-          }
-        });
+        },
+        tbb::simple_partitioner());
   });
+  poller.finish();
   lanes.active += active;
   lanes.slots += slots;
   return frame;

@@ -1,5 +1,6 @@
 // The SIMD backend: the kernel on packets of rays (packet.cpp, Google Highway), the best
-// instruction set this CPU has picked at run time, tiles scheduled on all cores with oneTBB.
+// instruction set this CPU has picked at run time, one packet a thread on all cores (oneTBB), each
+// taking blocks of tiles until none is left (simd::TileBlocks).
 // Float32 only.
 #pragma once
 
