@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -94,6 +95,34 @@ INSTANTIATE_TEST_SUITE_P(Gallery, SimdAgainstScalar, testing::ValuesIn(every_cas
 
 // Every instruction set this CPU runs (packets of 4, 8 or 16 rays, tiles of 2x2, 4x2 or 4x4)
 // gives the scalar backend's frame.
+// Every tile of the grid is handed out once, whichever thread asks and however many parts there
+// are (more parts than blocks too), and nothing once the blocks are gone.
+TEST(Simd, TileBlocksHandOutEveryTileOnce) {
+  for (const auto [rows, cols, parts] :
+       {std::array{90, 160, 2}, std::array{90, 160, 16}, std::array{3, 41, 7}, std::array{1, 1, 4},
+        std::array{0, 5, 2}, std::array{5, 0, 2}}) {
+    simd::TileBlocks blocks(rows, cols, parts);
+    std::vector<int> seen(static_cast<size_t>(rows) * static_cast<size_t>(cols), 0);
+    int row0 = 0, row1 = 0, col0 = 0, col1 = 0;
+    int64_t taken = 0;
+    // Parts ask in turn, the last one twice as often, as threads of unequal speed would.
+    for (int turn = 0; taken <= rows * cols; ++turn) {
+      const int part = turn % (parts + 1) == parts ? parts - 1 : turn % (parts + 1);
+      if (!blocks.take(part, row0, row1, col0, col1)) break;
+      ++taken;
+      ASSERT_TRUE(0 <= row0 && row0 < row1 && row1 <= rows && 0 <= col0 && col0 < col1 &&
+                  col1 <= cols);
+      for (int r = row0; r < row1; ++r)
+        for (int c = col0; c < col1; ++c) ++seen[static_cast<size_t>(r) * cols + c];
+    }
+    EXPECT_EQ(taken, blocks.taken());
+    EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }))
+        << rows << " x " << cols << " tiles, " << parts << " parts";
+    for (int part = 0; part < parts; ++part)
+      EXPECT_FALSE(blocks.take(part, row0, row1, col0, col1));
+  }
+}
+
 TEST(Simd, EveryInstructionSetAgreesWithScalar) {
   const std::vector<std::string> isas = simd::isa_names(true);
   ASSERT_FALSE(isas.empty());
