@@ -93,8 +93,6 @@ INSTANTIATE_TEST_SUITE_P(Gallery, SimdAgainstScalar, testing::ValuesIn(every_cas
                            return param.param.scene + "_" + to_string(param.param.method);
                          });
 
-// Every instruction set this CPU runs (packets of 4, 8 or 16 rays, tiles of 2x2, 4x2 or 4x4)
-// gives the scalar backend's frame.
 // Every tile of the grid is handed out once, whichever thread asks and however many parts there
 // are (more parts than blocks too), and nothing once the blocks are gone.
 TEST(Simd, TileBlocksHandOutEveryTileOnce) {
@@ -123,6 +121,8 @@ TEST(Simd, TileBlocksHandOutEveryTileOnce) {
   }
 }
 
+// Every instruction set this CPU runs (packets of 4, 8 or 16 rays, tiles of 2x2, 4x2 or 4x4)
+// gives the scalar backend's frame.
 TEST(Simd, EveryInstructionSetAgreesWithScalar) {
   const std::vector<std::string> isas = simd::isa_names(true);
   ASSERT_FALSE(isas.empty());
