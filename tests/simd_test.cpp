@@ -196,17 +196,22 @@ TEST(Simd, WholePassesOverWallsAndSolidsAgreeWithScalar) {
   }
 }
 
-// Whole passes whose lanes look their edges up rather than hold them (a room of more than
-// kHeldEdges edges): an L-shaped hexagon and a square glued edge to edge, a solid in the square.
-TEST(Simd, WholePassesLookingEdgesUpAgreeWithScalar) {
-  const Scene scene = parse_scene(R"({
+// An L-shaped hexagon and a square glued edge to edge, a solid in the square.
+Scene hexagon_and_square() {
+  return parse_scene(R"({
     "polygons": [[[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]],
                  [[3, 0], [4, 0], [4, 1], [3, 1]]],
     "gluings": [[[0, 1], [1, 3]], [[0, 3], [1, 1]], [[0, 2], [1, 0]], [[0, 4], [1, 2]],
                 [[0, 0], [0, 5]]],
     "objects": [{"type": "sphere", "polygon": 1, "center": [3.5, 0.5, 1], "radius": 0.2}],
     "camera": {"polygon": 0, "position": [0.5, 0.5, 1.0], "yaw_deg": 20, "pitch_deg": -5}})",
-                                  "hexagon and square");
+                     "hexagon and square");
+}
+
+// Whole passes whose lanes look their edges up rather than hold them (a room of more than
+// kHeldEdges edges).
+TEST(Simd, WholePassesLookingEdgesUpAgreeWithScalar) {
+  const Scene scene = hexagon_and_square();
   for (Method m : kKernelMethods) {
     MarchParams params;
     params.method = m;
@@ -216,6 +221,52 @@ TEST(Simd, WholePassesLookingEdgesUpAgreeWithScalar) {
           scalar, SimdBackend({.isa = isa}).render(scene, scene.camera, 96, 54, params, {}));
       expect_identical(n, std::string("hexagon and square ") + to_string(m) + " " + isa);
     }
+  }
+}
+
+// A frame of `scene` marched by the best instruction set's packets on one thread, its exit edges
+// found by the nearest line first where `nearest` (simd::PacketJob::exit_by_nearest_line; the
+// instruction sets below AVX-512 ignore it).
+Frame packet_frame(const Scene& scene, const MarchParams& params, int width, int height,
+                   bool nearest) {
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+  Frame frame(width, height);
+  simd::PacketJob job = simd::frame_job(tables, scene.camera, width, height, frame);
+  job.exit_by_nearest_line = nearest;
+  const simd::PacketCode code = simd::packet_code(0);
+  const simd::TileShape tile = simd::tile_shape(code.lanes());
+  simd::TileBlocks blocks((height + tile.height - 1) / tile.height,
+                          (width + tile.width - 1) / tile.width, 1);
+  simd::LaneCounts lanes;
+  code.march(job, blocks, 0, &lanes);
+  return frame;
+}
+
+// The analytic method's exit by the nearest line (nearest-inl.h) takes the scenes of several
+// convex rooms not alike, and finds the scalar kernel's exits: there, and forced on the L-shaped
+// hexagon, whose rays often meet the nearest line off its edge and take the full loop after it.
+TEST(Simd, ExitByTheNearestLineAgreesWithScalar) {
+  MarchParams analytic;
+  analytic.method = Method::analytic;
+  const auto taken = [&](const Scene& scene, const MarchParams& params) {
+    const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
+    return simd::packet_job(tables).exit_by_nearest_line;
+  };
+  EXPECT_TRUE(taken(test::gallery_scene("cube"), analytic));
+  EXPECT_TRUE(taken(test::gallery_scene("double_pentagon"), analytic));
+  EXPECT_FALSE(taken(test::gallery_scene("l_shape"), analytic));        // one room
+  EXPECT_FALSE(taken(hexagon_and_square(), analytic));                  // not convex
+  EXPECT_FALSE(taken(reports::staircase_surface(8, false), analytic));  // rooms alike
+  MarchParams sphere;
+  sphere.method = Method::sphere;
+  EXPECT_FALSE(taken(test::gallery_scene("cube"), sphere));
+
+  const Scene hexagon = hexagon_and_square();
+  for (const Scene* scene :
+       {&hexagon, &test::gallery_scene("cube"), &test::gallery_scene("double_pentagon")}) {
+    const Frame scalar = ScalarBackend().render(*scene, scene->camera, 96, 54, analytic, {});
+    expect_identical(compare(scalar, packet_frame(*scene, analytic, 96, 54, true)),
+                     scene->name + " by the nearest line");
   }
 }
 

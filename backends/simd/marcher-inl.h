@@ -33,6 +33,7 @@
 #include "backends/simd/events-inl.h"
 #include "backends/simd/lanes-inl.h"
 #include "backends/simd/maths-inl.h"
+#include "backends/simd/nearest-inl.h"
 #include "backends/simd/solids-inl.h"
 #include "backends/simd/walls-inl.h"
 
@@ -46,7 +47,8 @@ class Marcher : private RayEvents {
       : RayEvents(job, events, max_events),
         whole_(job.tables->polygons.size() > 1 && solids_.by_lane() &&
                walls_.whole(params_.method == kMethodAnalytic)),
-        one_room_(job.tables->polygons.size() == 1) {}
+        one_room_(job.tables->polygons.size() == 1),
+        nearest_(whole_ && walls_.glue_by_lane() && !walls_.same_rooms()) {}
 
   // Edges held by no lane.
   static void clear(HeldEdges& held) {
@@ -103,7 +105,10 @@ class Marcher : private RayEvents {
   // One iteration of march.glsl's march() loop for every lane not done: a step, then the end
   // of the rays that have taken max_steps. Where whole_, rays over several rooms take one whole
   // pass (Rooms::whole). Otherwise a step runs in passes of up to kRoomsPerPass rooms (usually
-  // one). Returns the rooms its passes went over, summed (a whole pass counts two).
+  // one). Returns the rooms its passes went over, summed (a whole pass counts two). kNearest:
+  // the analytic method's whole passes find their exit edge by the nearest line
+  // (ExitByNearestLine), where their edges are looked up by lane.
+  template <bool kNearest = false>
   FLATMARCH_PACKET_INLINE int step(Packet& r, Relaxation& x, Segment& seg, HeldEdges& held,
                                    LaneCounts& lanes) const {
     int rooms_seen = 0;
@@ -112,7 +117,7 @@ class Marcher : private RayEvents {
     std::array<int32_t, hn::MaxLanes(DI())> lane_rooms{};
     if (!one_room_) hn::StoreU(r.polygon, DI(), lane_rooms.data());
     M pending = active;
-    const bool analytic = params_.method == kMethodAnalytic;
+    const bool analytic = kNearest || params_.method == kMethodAnalytic;  // kNearest: analytic
     if (whole_ && Any(pending)) {
       // Rays over several rooms take one pass, reading the edges they hold or looking them up
       // by their rooms; rays in one room take the one-room pass below.
@@ -123,7 +128,7 @@ class Marcher : private RayEvents {
         count_lanes(lanes, pending);
         // Three calls, so that each inlined copy knows whether it reads held edges.
         if (analytic)
-          analytic_step<false>(r, seg, pending, rooms);
+          analytic_step<false, kNearest>(r, seg, pending, rooms);
         else if (hold)
           sphere_step<false>(r, x, pending, rooms, &held);
         else
@@ -252,13 +257,16 @@ class Marcher : private RayEvents {
     seg.solids = Select(m, hn::Max(seg.solids - s, Splat(0.0f)), seg.solids);
   }
 
-  // One iteration of the analytic method for the rays of `m`, in `rooms`.
-  template <bool kOneRoom>
+  // One iteration of the analytic method for the rays of `m`, in `rooms` (kNearest: step's).
+  template <bool kOneRoom, bool kNearest = false>
   FLATMARCH_PACKET_INLINE void analytic_step(Packet& r, Segment& seg, M m,
                                              const Rooms& rooms) const {
     const M unknown = hn::AndNot(seg.known, m);
     if (Any(unknown)) {
-      const Exit x = walls_.exit_edge<kOneRoom>(unknown, rooms, r.ox, r.oy, r.dx, r.dy);
+      const Exit x = kNearest && nearest_
+                         ? ExitByNearestLine(walls_, unknown, rooms, params_.vertex_tolerance, r.ox,
+                                             r.oy, r.dx, r.dy)
+                         : walls_.exit_edge<kOneRoom>(unknown, rooms, r.ox, r.oy, r.dx, r.dy);
       seg.exit.s = Select(unknown, x.s, seg.exit.s);
       seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
       seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
@@ -349,6 +357,7 @@ class Marcher : private RayEvents {
   // (Walls::whole).
   bool whole_;
   bool one_room_;  // the scene has one room: a step's pass needs no search for rooms
+  bool nearest_;   // whole passes look their edges up by lane (ExitByNearestLine applies)
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)

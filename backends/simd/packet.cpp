@@ -191,8 +191,10 @@ class PixelQueue {
 // writes them. The lanes of one packet take the pixels tile by tile, and a lane whose ray has
 // ended takes a next pixel soon (kRefillAt), so that a few long rays do not hold up the rest of
 // their tile; one block's pixels follow the last's in the same packet, so lanes stay busy until
-// the frame's pixels run out.
-void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
+// the frame's pixels run out. kNearest: Marcher::step's.
+template <bool kNearest>
+HWY_NOINLINE void MarchPacketsWith(const PacketJob& job, TileBlocks& blocks, int part,
+                                   LaneCounts* lanes) {
   const Marcher marcher(job, nullptr, 0);
   const DI di;
   constexpr size_t kMax = hn::MaxLanes(DI());
@@ -219,7 +221,7 @@ void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts
   // Every iteration steps at least one ray, and a ray takes at most max_steps steps.
   const int64_t bound = pixels * (int64_t{job.tables->params.max_steps} + 1) + 1;
   M occupied = None();  // lanes holding a pixel
-  const bool analytic = job.tables->params.method == kMethodAnalytic;
+  const bool analytic = kNearest || job.tables->params.method == kMethodAnalytic;
   bool spread = false;  // the analytic method's rays over several rooms (kRefillSpread)
   const size_t rooms_in_scene = job.tables->polygons.size();
   const bool mirrors = (job.tables->features & kFeatureMirrors) != 0u;
@@ -276,10 +278,28 @@ void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts
       }
     }
     if (hn::AllTrue(D(), r.done)) break;  // no pixels left and every ray written
-    const int rooms = marcher.step(r, x, seg, held, *lanes);
+    const int rooms = marcher.template step<kNearest>(r, x, seg, held, *lanes);
     spread = analytic && rooms > 2;
     if (patience > 0) ++waited;
   }
+}
+
+// MarchPacketsWith; where the job's exit is found by the nearest line, in a copy of its own for
+// the analytic method alone. Inlined into the one loop, the nearest line gave back what it saved
+// (double pentagon 0.94x, cube 0.98x) on the frames that never take it (4-square staircase
+// 1.04-1.09x, L-shape 1.02-1.04x: the code around the step compiled differently, NOTES.md); in a
+// copy of its own those are compiled as before. AVX-512 only: there the cube's edges and the
+// double pentagon's fit in two vectors (AVX2's hold the double pentagon's alone), and a copy for
+// every instruction set made this file's compile 196 -> 256 s (-O2 -g, one core; AVX-512's
+// alone, 216 s).
+void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
+#if HWY_TARGET <= HWY_AVX3
+  if (job.exit_by_nearest_line) {
+    MarchPacketsWith<true>(job, blocks, part, lanes);
+    return;
+  }
+#endif
+  MarchPacketsWith<false>(job, blocks, part, lanes);
 }
 
 // The rays of the frame's central tile (a packet's worth, clamped to the frame), started from the
@@ -358,6 +378,22 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace flatmarch::simd {
+namespace {
+
+// Whether polygon `p`'s edges all turn the same way.
+bool convex(const kernel::SceneTables<float>& tables, const kernel::ivec4& p) {
+  int left = 0, right = 0;
+  for (int k = 0; k < p.y; ++k) {
+    const glm::vec4 a = tables.edges[static_cast<size_t>(p.x + k)].segment;
+    const glm::vec4 b = tables.edges[static_cast<size_t>(p.x + (k + 1) % p.y)].segment;
+    const float turn = (a.z - a.x) * (b.w - b.y) - (a.w - a.y) * (b.z - b.x);
+    left += turn > 0.0f ? 1 : 0;
+    right += turn < 0.0f ? 1 : 0;
+  }
+  return left == 0 || right == 0;
+}
+
+}  // namespace
 
 PacketJob packet_job(const kernel::SceneTables<float>& tables) {
   PacketJob job;
@@ -368,6 +404,10 @@ PacketJob packet_job(const kernel::SceneTables<float>& tables) {
                                 e.segment.y + aby);
   }
   job.edges = edge_tables(tables, job.edge_extra);
+  job.exit_by_nearest_line = tables.params.method == kMethodAnalytic &&
+                             tables.polygons.size() > 1 && !job.edges.same_rooms &&
+                             std::all_of(tables.polygons.begin(), tables.polygons.end(),
+                                         [&](const kernel::ivec4& p) { return convex(tables, p); });
   return job;
 }
 

@@ -1,0 +1,95 @@
+// The analytic method's exit edge for a whole pass over several rooms (Rooms::whole, edges looked
+// up by lane), found by the nearest line first: Walls::exit_edge's answer, bit for bit, with
+// fewer edges tested for where along them the rays meet them.
+//
+// Walls::exit_edge keeps, over the edges a ray moves towards, the one least by a key: the least
+// max(s, 0) (s: the distance to the edge's line); at a tie an edge met at s < 0 before one met at
+// s >= 0, among those met at s < 0 the last, among the others the first. Each edge replaces the
+// exit so far exactly when its key is less, and only edges met on the edge (on_edge: the edge
+// parameter u within the tolerance) count. Without that test the same loop finds the least over
+// more edges; where that edge is met on the edge it is the least of those that are, so the full
+// loop ends on it too, with the same s and u. The lanes where it is not (in convex rooms, rays
+// near a vertex) take the full loop.
+//
+// In a whole pass over several rooms the full loop reads nine numbers of each edge by lane, for
+// slots that rays in other rooms move towards as well (the cube's faces and the double pentagon's
+// rooms turn rays against each other: 3.36 of the cube's 4 slots tested a pass where a lane moves
+// towards 2.00, NOTES.md). Here a slot costs its normal's three numbers, and the edge found its
+// six more once.
+
+// Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
+// re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
+#if defined(FLATMARCH_BACKENDS_SIMD_NEAREST_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef FLATMARCH_BACKENDS_SIMD_NEAREST_INL_H_
+#undef FLATMARCH_BACKENDS_SIMD_NEAREST_INL_H_
+#else
+#define FLATMARCH_BACKENDS_SIMD_NEAREST_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include "backends/simd/lanes-inl.h"
+#include "backends/simd/maths-inl.h"
+#include "backends/simd/walls-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace flatmarch::simd {
+namespace HWY_NAMESPACE {
+
+// Walls::exit_edge<false> for the rays of `m` in a whole pass whose edges are looked up by lane
+// (Walls::glue_by_lane, not Walls::same_rooms).
+FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Rooms& rooms,
+                                               float vertex_tolerance, V ox, V oy, V dhx, V dhy) {
+  const lane::vec2 o(ox, oy), dh(dhx, dhy);
+  const V least = Splat(-vertex_tolerance);
+  V s_exit = Splat(kFar), s_line = Splat(0.0f);
+  VI k_exit = SplatI(-1);
+  for (int k = 0; k < rooms.most_edges; ++k) {
+    const Walls::Slot at = walls.slot<false>(rooms, k);
+    const lane::vec2 n(walls.field<false>(at, kNx), walls.field<false>(at, kNy));
+    const V dn = lane::dot(dh, n).v;
+    const M towards = hn::And(hn::And(m, at.valid), dn > Splat(0.0f));
+    if (!Any(towards)) continue;
+    const V s = lane::line_distance(o, n, walls.field<false>(at, kNa), dn).v;
+    const M ok = hn::AndNot(hn::Or(s < least, s >= s_exit), towards);
+    s_exit = Select(ok, hn::Max(s, Splat(0.0f)), s_exit);
+    s_line = Select(ok, s, s_line);
+    k_exit = Select(ok, SplatI(k), k_exit);
+  }
+  // The edge found, each lane's own: its numbers looked up by lane (a slot number past those
+  // read alike by slot, so that field() looks every number up).
+  const M found = AtLeastZero(k_exit);
+  Walls::Slot at;
+  at.edge = 0;
+  at.k = kAlikeSlots;
+  at.rooms = &rooms;
+  at.valid = found;
+  at.edges = Select(found, rooms.first_edge + k_exit, SplatI(0));
+  const V u =
+      lane::edge_parameter(o + lane::real(s_line) * dh,
+                           lane::vec2(walls.field<false>(at, kAx), walls.field<false>(at, kAy)),
+                           lane::vec2(walls.field<false>(at, kAbx), walls.field<false>(at, kAby)),
+                           walls.field<false>(at, kInvLength2))
+          .v;
+  const V tolerance = walls.field<false>(at, kTolerance);
+  const M on = hn::And(found, lane::on_edge(u, tolerance).m);
+  Exit x;
+  x.s = Select(on, s_exit, Splat(kFar));
+  x.edge = Select(on, k_exit, SplatI(-1));
+  x.corner = lane::near_end(Select(on, u, Splat(0.5f)), Select(on, tolerance, Splat(0.0f))).m;
+  // Lanes with no edge found have the full loop's answer already (it finds none either).
+  const M rest = hn::AndNot(on, hn::And(m, found));
+  if (Any(rest)) {
+    const Exit full = walls.exit_edge<false>(rest, rooms, ox, oy, dhx, dhy);
+    x.s = Select(rest, full.s, x.s);
+    x.edge = Select(rest, full.edge, x.edge);
+    x.corner = hn::Or(hn::AndNot(rest, x.corner), hn::And(rest, full.corner));
+  }
+  return x;
+}
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace flatmarch::simd
+HWY_AFTER_NAMESPACE();
+#endif  // FLATMARCH_BACKENDS_SIMD_NEAREST_INL_H_
