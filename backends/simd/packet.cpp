@@ -19,6 +19,7 @@
 #include <stdexcept>
 
 #include "backends/simd/packet.hpp"
+#include "scene/geometry.hpp"
 // Per-target parts (after foreach_target.h, as it re-includes this file for each target).
 #include "backends/simd/lanes-inl.h"
 #include "backends/simd/marcher-inl.h"
@@ -386,9 +387,9 @@ bool convex(const kernel::SceneTables<float>& tables, const kernel::ivec4& p) {
   for (int k = 0; k < p.y; ++k) {
     const glm::vec4 a = tables.edges[static_cast<size_t>(p.x + k)].segment;
     const glm::vec4 b = tables.edges[static_cast<size_t>(p.x + (k + 1) % p.y)].segment;
-    const float turn = (a.z - a.x) * (b.w - b.y) - (a.w - a.y) * (b.z - b.x);
-    left += turn > 0.0f ? 1 : 0;
-    right += turn < 0.0f ? 1 : 0;
+    const double turn = cross(Vec2(a.z - a.x, a.w - a.y), Vec2(b.z - b.x, b.w - b.y));
+    left += turn > 0.0 ? 1 : 0;
+    right += turn < 0.0 ? 1 : 0;
   }
   return left == 0 || right == 0;
 }
