@@ -66,6 +66,22 @@ typename Tables<real>::ObjectRecord object_record(const Object& o, int hit_index
   return r;
 }
 
+// Whether every room's outline, as its edges' segments run, is convex: each edge starts where
+// the one before it ends and turns left of it or runs straight on (a simple counterclockwise
+// polygon that never turns right is convex; DESIGN.md makes polygons simple).
+template <typename real>
+bool convex_rooms(const SceneTables<real>& t) {
+  for (const ivec4& poly : t.polygons)
+    for (int k = 0; k < poly.y; ++k) {
+      const auto& s = t.edges[static_cast<size_t>(poly.x + k)].segment;
+      const auto& next = t.edges[static_cast<size_t>(poly.x + (k + 1) % poly.y)].segment;
+      const Vec2 ab(double(s.z) - double(s.x), double(s.w) - double(s.y));
+      const Vec2 bc(double(next.z) - double(next.x), double(next.w) - double(next.y));
+      if (next.x != s.z || next.y != s.w || ab.x * bc.y - ab.y * bc.x < 0.0) return false;
+    }
+  return true;
+}
+
 }  // namespace
 
 uint scene_features(const Scene& scene) {
@@ -165,6 +181,11 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
     t.polygons.push_back(ivec4(first_edge, edge_count, first_object,
                                static_cast<int>(t.objects.size()) - first_object));
   }
+
+  // Where every room is convex, a step far from the walls finds its distance to them from
+  // the edges' lines alone (march.glsl's wall_distance).
+  if (convex_rooms(t))
+    for (auto& e : t.edges) e.link.w = 1;
 
   typename Tables<real>::KernelParams& k = t.params;
   k.method = kernel_method(march.method);

@@ -106,6 +106,12 @@ KINLINE lane_bool crosses(real py, real ay, real by, vec2 ap, vec2 ab) {
   return (over_a && under_b && left) || !(over_a || under_b || left);
 }
 
+// How far the point p lies inside the line of unit outward normal n (x, y) and offset c (z):
+// negative beyond it.
+KINLINE real line_gap(vec2 p, vec4 line) {
+  return line.z - dot(p, vec2(line.x, line.y));
+}
+
 // How far a ray from o along dh goes to meet a line (unit normal n, offset c) that it moves
 // towards, dn = dot(dh, n) > 0 (dh's length makes this a 3D distance).
 KINLINE real line_distance(vec2 o, vec2 n, real c, real dn) {

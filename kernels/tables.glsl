@@ -10,7 +10,8 @@ struct EdgeRecord {
   vec4 line;        // outward unit normal n (x, y), dot(n, a) (z), 1 / |b - a|^2 (w)
   vec4 map_linear;  // the gluing map's linear part, columns (x, y) and (z, w)
   vec4 map_shift;   // its translation (x, y), 0, 0
-  ivec4 link;       // kind (kEdge*), destination polygon, destination edge, 0
+  ivec4 link;       // kind (kEdge*), destination polygon, destination edge, and 1 where
+                    // every room of the scene is convex, else 0 (the same on every edge)
   vec4 tint;        // glued or mirror: the colour (xyz) a crossing mixes in, and its opacity at
                     // normal incidence (w); a wall: 0
 };

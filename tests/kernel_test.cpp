@@ -3,6 +3,7 @@
 // (offset <= eps, max_steps, corners, grazing rays) ending with its documented event.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -38,14 +39,101 @@ TEST(SceneCompiler, TorusTablesHoldItsEdgesAndMaps) {
   EXPECT_EQ(bottom.line, glm::dvec4(0, -1, 0, 1.0 / 16));  // outward normal, n.a, 1/|ab|^2
   EXPECT_EQ(bottom.map_linear, glm::dvec4(1, 0, 0, 1));
   EXPECT_EQ(bottom.map_shift, glm::dvec4(0, 4, 0, 0));
-  EXPECT_EQ(bottom.link, glm::ivec4(kEdgeGlued, 0, 2, 0));
+  EXPECT_EQ(bottom.link, glm::ivec4(kEdgeGlued, 0, 2, 1));  // 1: the room is convex
   const auto& right = t.edges[1];
   EXPECT_EQ(right.line, glm::dvec4(1, 0, 4, 1.0 / 16));
   EXPECT_EQ(right.map_shift, glm::dvec4(-4, 0, 0, 0));
-  EXPECT_EQ(right.link, glm::ivec4(kEdgeGlued, 0, 3, 0));
+  EXPECT_EQ(right.link, glm::ivec4(kEdgeGlued, 0, 3, 1));
   EXPECT_EQ(t.params.height, 2.0);
   EXPECT_EQ(t.params.top, 2.0);
   EXPECT_EQ(t.params.polygon_count, 1);
+}
+
+// link.w marks every edge of a scene whose rooms are all convex, and no edge of any other:
+// a room that turns right once anywhere (the L-shape's corner, a 270-degree wedge) unmarks all.
+TEST(SceneCompiler, EdgesSayWhetherEveryRoomIsConvex) {
+  const auto marks = [](const std::string& json) {
+    std::vector<int> w;
+    for (const auto& e : kernel::compile_scene<float>(load(json), {}).edges) w.push_back(e.link.w);
+    return w;
+  };
+  EXPECT_EQ(marks(test::torus_json()), std::vector<int>(4, 1));
+  EXPECT_EQ(marks(test::cube_json()), std::vector<int>(24, 1));
+  // A square beside a pentagon with a point on its bottom edge (a straight angle): both convex.
+  EXPECT_EQ(marks(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                   [[0, 0], [1, 0], [2, 0], [2, 1], [0, 1]]],
+                      "gluings": [[[0, 1], [1, 4]], [[0, 3], [1, 2]]]})"),
+            std::vector<int>(9, 1));
+  // The same with the pentagon's second corner pushed in: the first room is convex, the
+  // second not, so neither is marked.
+  EXPECT_EQ(marks(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                   [[0, 0], [1, 0.5], [2, 0], [2, 1], [0, 1]]],
+                      "gluings": [[[0, 1], [1, 4]], [[0, 3], [1, 2]]]})"),
+            std::vector<int>(9, 0));
+  const Scene wedge = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, -1]}]],
+                               "gluings": [[[0, 0], [0, 2]]]})");
+  for (const auto& e : kernel::compile_scene<double>(wedge, {}).edges) EXPECT_EQ(e.link.w, 0);
+}
+
+// In convex rooms the kernel's distance to the walls comes from the edges' lines, and the
+// distance to the next nearest edge from its segment where the nearest is within eps: the
+// scene model's distances to the boundary and to each edge, and the nearest edge's number.
+TEST(Kernel, WallDistanceInAConvexRoomIsTheDistanceToItsBoundary) {
+  const Scene s =
+      load_scene(std::filesystem::path(FLATMARCH_SOURCE_DIR) / "scenes/double_pentagon.json");
+  const auto t = kernel::compile_scene<double>(s, {});
+  ASSERT_EQ(t.edges[0].link.w, 1);
+  ASSERT_EQ(t.features, kFeatureObjects);  // a hollow cube
+  auto k = kernel::bind_kernel<double, kFeatureObjects>(t);
+  const double eps = t.params.eps;
+  // The distance from p to edge e of `room`, by hand.
+  const auto to_edge = [](const Polygon& room, int e, Vec2 p) {
+    const Vec2 a = room.vertex(e), ab = room.vertex(e + 1) - a;
+    const double h = std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0);
+    return glm::length(p - a - h * ab);
+  };
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int far = 0;
+  for (int p = 0; p < 2; ++p) {
+    const Polygon& room = s.polygons[static_cast<size_t>(p)];
+    for (int n = 0; n < 400; ++n) {
+      // A point of the room, or one 1e-5 inside edge n % 5 (within eps = 1e-4), or 1e-5 inside
+      // it near its end, within eps of the next edge too.
+      Vec2 at;
+      const int e = n % room.size();
+      const Vec2 a = room.vertex(e), b = room.vertex(e + 1);
+      const Vec2 inward = -room.edges[static_cast<size_t>(e)].normal;
+      if (n % 3 == 0) {
+        at = room.vertex(0) + unit(random) * (room.vertex(2) - room.vertex(0));
+        at += 0.9 * unit(random) * (room.vertex(3) - at);
+      } else if (n % 3 == 1) {
+        at = a + (0.1 + 0.8 * unit(random)) * (b - a) + 1e-5 * inward;
+      } else {
+        at = b + 5e-5 * glm::normalize(a - b) + 1e-5 * inward;
+      }
+      ASSERT_TRUE(room.contains(at)) << p << " " << n;
+      const auto d = k.wall_distance(p, glm::dvec2(at));
+      EXPECT_NEAR(d.d, room.distance_to_boundary(at), 1e-12) << p << " " << n;
+      int nearest = 0;
+      for (int j = 1; j < room.size(); ++j)
+        if (to_edge(room, j, at) < to_edge(room, nearest, at)) nearest = j;
+      EXPECT_EQ(d.edge, nearest) << p << " " << n;
+      if (d.d >= eps) {
+        ++far;
+        EXPECT_EQ(d.second, std::sqrt(double(kFar))) << p << " " << n;
+        continue;
+      }
+      double next = 1e300;
+      for (int j = 0; j < room.size(); ++j)
+        if (j != nearest) next = std::min(next, to_edge(room, j, at));
+      EXPECT_NEAR(d.second, next, 1e-12) << p << " " << n;
+      if (n % 3 == 2) {
+        EXPECT_LT(d.second, eps) << p << " " << n;  // a corner
+      }
+    }
+  }
+  EXPECT_GT(far, 200);  // most of the room's own points are far from every edge
 }
 
 TEST(SceneCompiler, FeaturesAreWhatTheSceneUses) {

@@ -178,7 +178,9 @@ struct Rooms {
 // made it 1.05-1.2x slower. Rooms alike in every number (Walls::same_rooms: a staircase whose
 // squares are drawn in one place) hold nothing: their edges are read by broadcast.
 constexpr int kHeldEdges = 5;
-constexpr std::array<Field, 6> kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
+// The lines' numbers (the last three) are what a step in convex rooms reads far from the walls.
+using HeldFields = std::array<Field, 9>;
+constexpr HeldFields kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2, kNx, kNy, kNa};
 struct HeldEdges {
   VI polygon;                                             // the room each lane holds, -1: none
   VI first_edge, edge_count;                              // its edges in the edge table

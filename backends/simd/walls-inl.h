@@ -52,7 +52,8 @@ class Walls {
         edges_(job.tables->edges.data()),
         extra_(job.edge_extra.data()),
         params_(job.tables->params),
-        features_(job.tables->features) {
+        features_(job.tables->features),
+        convex_(!job.tables->edges.empty() && job.tables->edges[0].link.w != 0) {
     // Passes over several rooms read each lane's edge from the scene's edge numbers: by a lookup
     // in up to kMostVectors vectors when the edges fit in them, else by a broadcast per room
     // blended by lane (cheaper than a gather), for scenes of up to kMostEdges edges.
@@ -235,9 +236,53 @@ class Walls {
   }
 
   // `held`: the edges the lanes hold, read instead of the tables where not null (a whole pass).
+  // Where the rooms are convex, the nearest edge's line gives the distance, and the segments
+  // are searched only where some lane is within eps of it (march.glsl's wall_distance).
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE WallDistance wall_distance(const Rooms& rooms, const HeldEdges* held,
                                                      V px, V py) const {
+    if (!convex_) return nearest_edge<kOneRoom>(rooms, held, px, py);
+    WallDistance w{Splat(kFar), SplatI(-1), Splat(kFar)};
+    M lanes = None();
+    const lane::vec2 p(px, py);
+    const int most = held ? kHeldEdges : rooms.most_edges;
+    for (int k = 0; k < most; ++k) {
+      if (held && k >= rooms.most_edges) break;
+      const Slot at = slot<kOneRoom>(rooms, k);
+      const auto read = [&](Field f) FLATMARCH_PACKET_LAMBDA {
+        if (!kOneRoom && held) return held->number[static_cast<size_t>(k)][f];
+        return field<kOneRoom>(at, f);
+      };
+      const V gap = lane::line_gap(p, lane::vec4{read(kNx), read(kNy), read(kNa), 0.0f}).v;
+      const M nearer = hn::And(at.valid, gap < w.d);
+      w.d = Select(nearer, gap, w.d);
+      w.edge = Select(nearer, SplatI(k), w.edge);
+      lanes = hn::Or(lanes, at.valid);
+    }
+    const M close = hn::And(lanes, w.d < Splat(params_.eps));
+    V next = Splat(kFar);
+    if (Any(close)) {
+      for (int k = 0; k < most; ++k) {
+        if (held && k >= rooms.most_edges) break;
+        const Slot at = slot<kOneRoom>(rooms, k);
+        const auto read = [&](Field f) FLATMARCH_PACKET_LAMBDA {
+          if (!kOneRoom && held) return held->number[static_cast<size_t>(k)][f];
+          return field<kOneRoom>(at, f);
+        };
+        const lane::vec2 ap(px - read(kAx), py - read(kAy)), ab(read(kAbx), read(kAby));
+        const V d2 = lane::segment_distance2(ap, ab, read(kInvLength2)).v;
+        const M other = hn::AndNot(Equal(w.edge, k), hn::And(close, at.valid));
+        next = Select(other, hn::Min(next, d2), next);
+      }
+    }
+    w.second = hn::Sqrt(next);
+    return w;
+  }
+
+  // March.glsl's wall_distance by its search of every edge.
+  template <bool kOneRoom>
+  FLATMARCH_PACKET_INLINE WallDistance nearest_edge(const Rooms& rooms, const HeldEdges* held, V px,
+                                                    V py) const {
     V best = Splat(kFar), second = Splat(kFar);
     VI edge = SplatI(-1);
     M inside = None();
@@ -482,6 +527,7 @@ class Walls {
   int slot_count_ = 0;
   KernelParams params_;
   uint features_;
+  bool convex_;  // every room is convex (the edge table's link.w): see wall_distance
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)
