@@ -93,8 +93,9 @@ bool inside_polygon(int polygon, vec2 p) {
 
 // Distance from a point to the walls of its room: to the nearest edge (negative outside the
 // polygon), which edge that is, and the distance to the next nearest one. Where the rooms are
-// convex, outside is beyond the nearest edge's line, and the next nearest is sqrt(kFar) unless
-// the nearest is within eps.
+// convex, outside is beyond the nearest edge's line, and the next nearest is the distance to
+// the next nearest line unless the nearest two lines are both within eps (never less than the
+// distance to its edge, so a corner, next nearest within eps, is found the same).
 struct WallDistance {
   real d;
   int edge;
@@ -106,27 +107,32 @@ WallDistance wall_distance(int polygon, vec2 p) {
   if (edges[poly.x].link.w != 0) {
     // The rooms are convex: inside, the nearest edge is as near as the nearest edge's line (the
     // foot of the perpendicular to that line lies on the edge), and a point is outside where it
-    // is beyond a line. The next nearest edge is wanted only where the nearest is within eps.
+    // is beyond a line. No edge is nearer than its line, so the segments are measured only
+    // where the nearest and the next nearest line are both within eps: a corner, perhaps.
     WallDistance v;
     v.d = real(kFar);
     v.edge = -1;
+    v.second = real(kFar);
     for (int k = 0; k < poly.y; ++k) {
       real gap = line_gap(p, edges[poly.x + k].line);
       if (gap < v.d) {
+        v.second = v.d;
         v.d = gap;
         v.edge = k;
+      } else if (gap < v.second) {
+        v.second = gap;
       }
     }
-    real next = real(kFar);
-    if (v.d < params.eps) {
+    if (v.d < params.eps && v.second < params.eps) {
+      real next = real(kFar);
       for (int k = 0; k < poly.y; ++k) {
         vec4 s = edges[poly.x + k].segment;
         vec2 a = vec2(s.x, s.y);
         real d2 = segment_distance2(p - a, vec2(s.z, s.w) - a, edges[poly.x + k].line.w);
         if (k != v.edge) next = min(next, d2);
       }
+      v.second = sqrt(next);
     }
-    v.second = sqrt(next);
     return v;
   }
   real best = real(kFar);

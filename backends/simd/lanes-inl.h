@@ -167,24 +167,24 @@ struct Rooms {
 
 // Sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges each (the
 // cube, the staircases drawn apart): each lane holds the numbers of its room's edges that a step
-// reads (kHeldFields), taken when a pass over several rooms first finds the lane in a room it does
-// not hold (Walls::hold), so that such a pass reads each lane's edges with a load instead of a
-// lookup or a broadcast per room blended by lane. A ray crosses once every 20-100 steps there,
-// so a lane's edges are taken far less often than they are read. With the whole passes this
-// allows (Rooms::whole), against passes of up to eight rooms blended or looked up (640x360, 2
+// reads (kHeldSegments or kHeldLines), taken when a pass over several rooms first finds the lane in
+// a room it does not hold (Walls::hold), so that such a pass reads each lane's edges with a load
+// instead of a lookup or a broadcast per room blended by lane. A ray crosses once every 20-100
+// steps there, so a lane's edges are taken far less often than they are read. With the whole passes
+// this allows (Rooms::whole), against passes of up to eight rooms blended or looked up (640x360, 2
 // cores, AVX-512, interleaved rounds): staircases of 32 and 128 squares 0.56-0.60x the time,
 // the cube 0.74x, the pillowcase 0.88x; the double pentagon's five edges 0.85-0.92x (0.80x on
 // AVX2, 0.73x on SSE4). The analytic method crosses at almost every step, and holding its edges
 // made it 1.05-1.2x slower. Rooms alike in every number (Walls::same_rooms: a staircase whose
 // squares are drawn in one place) hold nothing: their edges are read by broadcast.
 constexpr int kHeldEdges = 5;
-// The lines' numbers (the last three) are what a step in convex rooms reads far from the walls.
-using HeldFields = std::array<Field, 9>;
-constexpr HeldFields kHeldFields{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2, kNx, kNy, kNa};
+// The segments' numbers, or where every room is convex the lines' (Walls::wall_distance).
+constexpr std::array<Field, 6> kHeldSegments{kAx, kAy, kAbx, kAby, kAyAby, kInvLength2};
+constexpr std::array<Field, 3> kHeldLines{kNx, kNy, kNa};
 struct HeldEdges {
   VI polygon;                                             // the room each lane holds, -1: none
   VI first_edge, edge_count;                              // its edges in the edge table
-  std::array<std::array<V, kFields>, kHeldEdges> number;  // [edge][field], kHeldFields only
+  std::array<std::array<V, kFields>, kHeldEdges> number;  // [edge][field], those held only
 };
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE

@@ -130,11 +130,17 @@ class Walls {
       const M in = hn::And(left, Equal(polygon, p));
       left = hn::AndNot(in, left);
       const ivec4 poly = polygons_[p];
-      for (int k = 0; k < poly.y; ++k)
-        for (const Field f : kHeldFields) {
+      for (int k = 0; k < poly.y; ++k) {
+        const auto take = [&](Field f) FLATMARCH_PACKET_LAMBDA {
           V& v = held.number[static_cast<size_t>(k)][f];
           v = Select(in, Splat(lookup_[f][static_cast<size_t>(poly.x + k)]), v);
+        };
+        if (convex_) {
+          for (const Field f : kHeldLines) take(f);
+        } else {
+          for (const Field f : kHeldSegments) take(f);
         }
+      }
       held.first_edge = Select(in, SplatI(poly.x), held.first_edge);
       held.edge_count = Select(in, SplatI(poly.y), held.edge_count);
     }
@@ -237,7 +243,7 @@ class Walls {
 
   // `held`: the edges the lanes hold, read instead of the tables where not null (a whole pass).
   // Where the rooms are convex, the nearest edge's line gives the distance, and the segments
-  // are searched only where some lane is within eps of it (march.glsl's wall_distance).
+  // are measured only where some lane is within eps of two lines (march.glsl's wall_distance).
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE WallDistance wall_distance(const Rooms& rooms, const HeldEdges* held,
                                                      V px, V py) const {
@@ -255,18 +261,21 @@ class Walls {
       };
       const V gap = lane::line_gap(p, lane::vec4{read(kNx), read(kNy), read(kNa), 0.0f}).v;
       const M nearer = hn::And(at.valid, gap < w.d);
+      w.second = Select(nearer, w.d, Select(hn::And(at.valid, gap < w.second), gap, w.second));
       w.d = Select(nearer, gap, w.d);
       w.edge = Select(nearer, SplatI(k), w.edge);
       lanes = hn::Or(lanes, at.valid);
     }
-    const M close = hn::And(lanes, w.d < Splat(params_.eps));
-    V next = Splat(kFar);
+    const V eps = Splat(params_.eps);
+    const M close = hn::And(lanes, hn::And(w.d < eps, w.second < eps));
     if (Any(close)) {
+      V next = Splat(kFar);
       for (int k = 0; k < most; ++k) {
         if (held && k >= rooms.most_edges) break;
         const Slot at = slot<kOneRoom>(rooms, k);
+        // Lanes hold their lines only (hold): a gather of the segments, rare enough (corners).
         const auto read = [&](Field f) FLATMARCH_PACKET_LAMBDA {
-          if (!kOneRoom && held) return held->number[static_cast<size_t>(k)][f];
+          if (!kOneRoom && held) return hn::GatherIndex(D(), lookup_[f].data(), at.edges);
           return field<kOneRoom>(at, f);
         };
         const lane::vec2 ap(px - read(kAx), py - read(kAy)), ab(read(kAbx), read(kAby));
@@ -274,8 +283,8 @@ class Walls {
         const M other = hn::AndNot(Equal(w.edge, k), hn::And(close, at.valid));
         next = Select(other, hn::Min(next, d2), next);
       }
+      w.second = Select(close, hn::Sqrt(next), w.second);
     }
-    w.second = hn::Sqrt(next);
     return w;
   }
 
