@@ -93,9 +93,9 @@ bool inside_polygon(int polygon, vec2 p) {
 
 // Distance from a point to the walls of its room: to the nearest edge (negative outside the
 // polygon), which edge that is, and the distance to the next nearest one. Where the rooms are
-// convex, outside is beyond the nearest edge's line, and the next nearest is the distance to
-// the next nearest line unless the nearest two lines are both within eps (never less than the
-// distance to its edge, so a corner, next nearest within eps, is found the same).
+// convex, outside is beyond the nearest edge's line, and the next nearest is the next nearest
+// line's distance unless the nearest two lines are both within eps: no edge is nearer than its
+// line, so only there can a second edge be within eps (a corner), and the same corners are found.
 struct WallDistance {
   real d;
   int edge;
