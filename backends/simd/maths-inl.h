@@ -191,6 +191,20 @@ HWY_INLINE void Normalize(V& x, V& y, V& z) {
   y = n.y.v;
   z = n.z.v;
 }
+
+// The rays of `m` cross a glued wall or mirror of tint `tint` (the edge table's) whose outward
+// unit normal is n: march.glsl's cross_edge mixes its colour, fogged, into what they see.
+HWY_INLINE void Tint(Packet& r, M m, const KernelParams& params, const lane::vec4& tint,
+                     lane::real cosine) {
+  const lane::real a = lane::wall_opacity(tint.w, cosine);
+  const lane::vec3 colour = lane::fogged(lane::vec3(tint), lane::vec3(lane::Broadcast(params.fog)),
+                                         r.t, params.fog_distance);
+  const lane::vec3 light = lane::tint_light(lane::vec3(r.lr, r.lg, r.lb), r.clear, a, colour);
+  r.lr = Select(m, light.x.v, r.lr);
+  r.lg = Select(m, light.y.v, r.lg);
+  r.lb = Select(m, light.z.v, r.lb);
+  r.clear = Select(m, (lane::real(r.clear) * (lane::real(1.0f) - a)).v, r.clear);
+}
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
 }  // namespace flatmarch::simd

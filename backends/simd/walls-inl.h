@@ -1,10 +1,10 @@
 // The walls of a pass's rooms for packets of rays: distances to them, where rays leave by them,
-// which are opaque, and what a gluing does to the rays that cross one (march.glsl's "Walls").
-// A pass's table reads are one broadcast record per room, or, where a pass spans several rooms,
-// a broadcast of numbers alike in every room, a load of the edges each lane holds (HeldEdges:
-// sphere and relaxed tracing in rooms of at most kHeldEdges edges), a lookup of each lane's edge
-// in one or two vectors holding the scene's edges, or, for more edges, a broadcast per room
-// blended by lane.
+// which are opaque, and what a gluing does to the rays that cross one (march.glsl's "Walls"; the
+// gluing's map itself is in gluings-inl.h). A pass's table reads are one broadcast record per
+// room, or, where a pass spans several rooms, a broadcast of numbers alike in every room, a load
+// of the edges each lane holds (HeldEdges: sphere and relaxed tracing in rooms of at most
+// kHeldEdges edges), a lookup of each lane's edge in one or two vectors holding the scene's
+// edges, or, for more edges, a broadcast per room blended by lane.
 
 // Per-target include guard: this file is included once per instruction set (hwy/foreach_target.h
 // re-includes packet.cpp for each), so the guard toggles with HWY_TARGET_TOGGLE.
@@ -21,26 +21,13 @@
 #include <array>
 #include <vector>
 
+#include "backends/simd/gluings-inl.h"
 #include "backends/simd/lanes-inl.h"
 #include "backends/simd/maths-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
-
-// The rays of `m` cross a glued wall or mirror of tint `tint` (the edge table's) whose outward
-// unit normal is n: march.glsl's cross_edge mixes its colour, fogged, into what they see.
-HWY_INLINE void Tint(Packet& r, M m, const KernelParams& params, const lane::vec4& tint,
-                     lane::real cosine) {
-  const lane::real a = lane::wall_opacity(tint.w, cosine);
-  const lane::vec3 colour = lane::fogged(lane::vec3(tint), lane::vec3(lane::Broadcast(params.fog)),
-                                         r.t, params.fog_distance);
-  const lane::vec3 light = lane::tint_light(lane::vec3(r.lr, r.lg, r.lb), r.clear, a, colour);
-  r.lr = Select(m, light.x.v, r.lr);
-  r.lg = Select(m, light.y.v, r.lg);
-  r.lb = Select(m, light.z.v, r.lb);
-  r.clear = Select(m, (lane::real(r.clear) * (lane::real(1.0f) - a)).v, r.clear);
-}
 
 class Walls {
  public:
@@ -62,17 +49,9 @@ class Walls {
     const size_t edges = tables.edges.size(), lanes = hn::Lanes(D());
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
     mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
-    glue_by_slot_ = mode_ != kTable && t.glue_by_slot &&
-                    static_cast<size_t>(t.most_edges) <= lanes && t.tints.size() <= 2 * lanes;
-    two_tint_vectors_ = t.tints.size() > lanes;
-    if (glue_by_slot_) {
-      slot_glue_ = t.slot_glue;
-      for (size_t c = 0; c < 4; ++c)
-        for (size_t k = 0; k < t.tints.size(); ++k)
-          slot_tint_[c][k] = t.tints[k][static_cast<int>(c)];
-      slot_code_ = t.slot_code.data();
-      slot_count_ = t.most_edges;
-    }
+    if (mode_ != kTable && t.glue_by_slot && static_cast<size_t>(t.most_edges) <= lanes &&
+        t.tints.size() <= 2 * lanes)
+      by_slot_.take(t);
     if (mode_ == kSingle) return;
     most_edges_ = t.most_edges;
     held_ = tables.params.method != kMethodAnalytic && tables.polygons.size() > 1 &&
@@ -415,62 +394,21 @@ class Walls {
       return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
     };
     const lane::vec4 tint{glue(11), glue(12), glue(13), glue(14)};
-    glue_rays(r, m, glue, tint, lookup(DI(), to_polygon_, at), push);
+    GlueRays(r, m, params_, features_, glue, tint, lookup(DI(), to_polygon_, at), push);
   }
 
   // Whether crossings read each lane's gluing by its slot (EdgeTables::glue_by_slot), in scenes
   // whose edges do not fit in vectors: a lookup in a vector for the gluing, one gather for the
   // destination room and the tint's number, instead of a round per room and edge crossed.
-  bool glue_by_slot() const { return glue_by_slot_; }
+  bool glue_by_slot() const { return by_slot_.on(); }
   // The rays of `m` go through their edge `edge` (glued; its slot in their room), as
   // cross_glued.
   FLATMARCH_PACKET_INLINE void cross_by_slot(Packet& r, M m, VI edge, V push) const {
-    const DI di;
-    const VI slot = Select(m, edge, SplatI(0));
-    const auto by_slot = hn::IndicesFromVec(D(), slot);
-    const auto glue = [&](size_t f) FLATMARCH_PACKET_LAMBDA {
-      return hn::TableLookupLanes(hn::LoadU(D(), slot_glue_[f].data()), by_slot);
-    };
-    const VI at = Select(m, r.polygon * SplatI(slot_count_) + slot, SplatI(0));
-    const VI code = hn::GatherIndex(di, slot_code_, at);
-    // The tints in one vector, or two (AVX2: the staircases' ten on 8 lanes; AVX-512's 16
-    // lanes hold every tint glue_by_slot allows).
-    const VI number = hn::ShiftRight<16>(code);
-    const auto tint = [&](size_t c) FLATMARCH_PACKET_LAMBDA {
-      const float* table = slot_tint_[c].data();
-      if (hn::MaxLanes(D()) >= kAlikeSlots || !two_tint_vectors_)
-        return hn::TableLookupLanes(hn::LoadU(D(), table), hn::IndicesFromVec(D(), number));
-      const int lanes = static_cast<int>(hn::Lanes(D()));
-      const auto low = hn::IndicesFromVec(D(), hn::And(number, SplatI(lanes - 1)));
-      const M upper = hn::RebindMask(D(), number > SplatI(lanes - 1));
-      return Select(upper, hn::TableLookupLanes(hn::LoadU(D(), table + lanes), low),
-                    hn::TableLookupLanes(hn::LoadU(D(), table), low));
-    };
-    glue_rays(r, m, glue, lane::vec4{tint(0), tint(1), tint(2), tint(3)},
-              hn::And(code, SplatI(0xffff)), push);
+    by_slot_.cross(r, m, edge, push, params_, features_);
   }
 
  private:
   bool has(uint feature) const { return (features_ & feature) != 0u; }
-
-  // March.glsl's cross_edge for the glued edges of `m`: `glue(f)` gives each lane's glue field
-  // f (EdgeTables), `tint` its edge's tint, `to` the room it enters.
-  template <typename Glue>
-  FLATMARCH_PACKET_INLINE void glue_rays(Packet& r, M m, const Glue& glue, const lane::vec4& tint,
-                                         VI to, V push) const {
-    const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
-    const lane::vec4 shift{glue(0), glue(1), 0.0f, 0.0f};
-    const lane::vec4 to_line{glue(6), glue(7), glue(8), 0.0f};
-    Tint(r, m, params_, tint, lane::dot(lane::vec2(r.dx, r.dy), lane::vec2(glue(9), glue(10))));
-    const lane::vec2 p =
-        lane::place(lane::glue_point(linear, shift, lane::vec2(r.ox, r.oy)), to_line, push);
-    const lane::vec2 dh = lane::glue_direction(linear, lane::vec2(r.dx, r.dy));
-    V px = p.x.v, py = p.y.v, hx = dh.x.v, hy = dh.y.v, hz = r.dz;
-    if (has(kFeatureScaled)) Normalize(hx, hy, hz);
-    r.polygon = Select(m, to, r.polygon);
-    MoveTo(r, m, px, py, hx, hy, hz);
-    r.crossings = Select(m, r.crossings + SplatI(1), r.crossings);
-  }
 
   const ivec4* polygons_;
   const EdgeRecord* edges_;
@@ -481,29 +419,9 @@ class Walls {
   template <typename T>
   using Table = std::array<T, kMostEdges>;
 
-  // Entry `index` of `table` for each lane, the table held in one vector or two (kTable): in
-  // two, a lookup in each and the lane's own kept.
   template <class DT, typename T>
   FLATMARCH_PACKET_INLINE hn::Vec<DT> lookup(DT d, const Table<T>& table, VI index) const {
-    if (vectors_ == 1)
-      return hn::TableLookupLanes(hn::LoadU(d, table.data()), hn::IndicesFromVec(d, index));
-    const int lanes = static_cast<int>(hn::Lanes(d));
-#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
-    // AVX-512 looks up in two vectors in one instruction (Highway 1.0.3 has no
-    // TwoTablesLookupLanes): the cube's analytic frames 0.93-0.94x the time of two lookups and
-    // a blend (5 interleaved rounds), the double pentagon's 0.95-0.99x.
-    if constexpr (sizeof(T) == 4 && hn::MaxLanes(d) == 16) {
-      const auto low = hn::LoadU(d, table.data()), high = hn::LoadU(d, table.data() + lanes);
-      if constexpr (hwy::IsFloat<T>())
-        return hn::Vec<DT>{_mm512_permutex2var_ps(low.raw, index.raw, high.raw)};
-      else
-        return hn::Vec<DT>{_mm512_permutex2var_epi32(low.raw, index.raw, high.raw)};
-    }
-#endif
-    const auto low = hn::IndicesFromVec(d, hn::And(index, SplatI(lanes - 1)));
-    const auto upper = hn::RebindMask(d, hn::Gt(index, SplatI(lanes - 1)));
-    return hn::IfThenElse(upper, hn::TableLookupLanes(hn::LoadU(d, table.data() + lanes), low),
-                          hn::TableLookupLanes(hn::LoadU(d, table.data()), low));
+    return LookUp(d, table.data(), vectors_, index);
   }
 
   // How a pass over several rooms reads its lanes' edges.
@@ -526,14 +444,7 @@ class Walls {
   bool same_count_ = false;  // every room has most_edges_ edges
   Table<int32_t> to_polygon_, first_edge_, edge_count_;
   Table<int32_t> wall_;  // of each edge: -1 an opaque wall, else 0
-  // glue_by_slot(): the gluings' numbers by slot, the tints by number (rgba), and each room's
-  // slots' destination and tint number (EdgeTables::slot_code, the job's), its rooms' edges.
-  bool glue_by_slot_ = false;
-  bool two_tint_vectors_ = false;  // more tints than lanes
-  std::array<std::array<float, kAlikeSlots>, kSlotGlueFields> slot_glue_{};
-  std::array<std::array<float, kAlikeSlots>, 4> slot_tint_{};
-  const int32_t* slot_code_ = nullptr;
-  int slot_count_ = 0;
+  SlotGluings by_slot_;  // glue_by_slot()
   KernelParams params_;
   uint features_;
   bool convex_;  // every room is convex (the edge table's link.w): see wall_distance
