@@ -76,14 +76,7 @@ class SlotGluings {
     // lanes hold every tint glue_by_slot allows).
     const VI number = hn::ShiftRight<16>(code);
     const auto tint = [&](size_t c) FLATMARCH_PACKET_LAMBDA {
-      const float* table = tint_[c].data();
-      if (hn::MaxLanes(D()) >= kAlikeSlots || !two_tint_vectors_)
-        return hn::TableLookupLanes(hn::LoadU(D(), table), hn::IndicesFromVec(D(), number));
-      const int lanes = static_cast<int>(hn::Lanes(D()));
-      const auto low = hn::IndicesFromVec(D(), hn::And(number, SplatI(lanes - 1)));
-      const M upper = hn::RebindMask(D(), number > SplatI(lanes - 1));
-      return Select(upper, hn::TableLookupLanes(hn::LoadU(D(), table + lanes), low),
-                    hn::TableLookupLanes(hn::LoadU(D(), table), low));
+      return LookUp(D(), tint_[c].data(), two_tint_vectors_ ? 2 : 1, number);
     };
     GlueRays(r, m, params, features, glue, lane::vec4{tint(0), tint(1), tint(2), tint(3)},
              hn::And(code, SplatI(0xffff)), push);
