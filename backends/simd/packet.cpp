@@ -19,7 +19,6 @@
 #include <stdexcept>
 
 #include "backends/simd/packet.hpp"
-#include "scene/geometry.hpp"
 // Per-target parts (after foreach_target.h, as it re-includes this file for each target).
 #include "backends/simd/lanes-inl.h"
 #include "backends/simd/marcher-inl.h"
@@ -379,23 +378,6 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace flatmarch::simd {
-namespace {
-
-// Whether polygon `p`'s edges all turn the same way.
-bool convex(const kernel::SceneTables<float>& tables, const kernel::ivec4& p) {
-  int left = 0, right = 0;
-  for (int k = 0; k < p.y; ++k) {
-    const glm::vec4 a = tables.edges[static_cast<size_t>(p.x + k)].segment;
-    const glm::vec4 b = tables.edges[static_cast<size_t>(p.x + (k + 1) % p.y)].segment;
-    const double turn = cross(Vec2(a.z - a.x, a.w - a.y), Vec2(b.z - b.x, b.w - b.y));
-    left += turn > 0.0 ? 1 : 0;
-    right += turn < 0.0 ? 1 : 0;
-  }
-  return left == 0 || right == 0;
-}
-
-}  // namespace
-
 PacketJob packet_job(const kernel::SceneTables<float>& tables) {
   PacketJob job;
   job.tables = &tables;
@@ -405,10 +387,10 @@ PacketJob packet_job(const kernel::SceneTables<float>& tables) {
                                 e.segment.y + aby);
   }
   job.edges = edge_tables(tables, job.edge_extra);
+  // The scene compiler marks every edge (link.w) where every room is convex.
   job.exit_by_nearest_line = tables.params.method == kMethodAnalytic &&
                              tables.polygons.size() > 1 && !job.edges.same_rooms &&
-                             std::all_of(tables.polygons.begin(), tables.polygons.end(),
-                                         [&](const kernel::ivec4& p) { return convex(tables, p); });
+                             tables.edges[0].link.w != 0;
   return job;
 }
 
