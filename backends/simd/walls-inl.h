@@ -238,11 +238,15 @@ class Walls {
         if (!kOneRoom && held) return held->number[static_cast<size_t>(k)][f];
         return field<kOneRoom>(at, f);
       };
-      const V gap = lane::line_gap(p, lane::vec4{read(kNx), read(kNy), read(kNa), 0.0f}).v;
-      const M nearer = hn::And(at.valid, gap < w.d);
-      w.second = Select(nearer, w.d, Select(hn::And(at.valid, gap < w.second), gap, w.second));
-      w.d = Select(nearer, gap, w.d);
-      w.edge = Select(nearer, SplatI(k), w.edge);
+      V gap = lane::line_gap(p, lane::vec4{read(kNx), read(kNy), read(kNa), 0.0f}).v;
+      // Lanes whose room has no edge k: none (in one room, or rooms of as many edges, every
+      // lane of the pass has it, and the rest are not read).
+      if (!kOneRoom && !same_count_) gap = Select(at.valid, gap, Splat(kFar));
+      // The least two by min and max (w.d <= w.second throughout): the selects they replace
+      // gave the same numbers.
+      w.edge = Select(gap < w.d, SplatI(k), w.edge);
+      w.second = hn::Min(hn::Max(gap, w.d), w.second);
+      w.d = hn::Min(gap, w.d);
       lanes = hn::Or(lanes, at.valid);
     }
     const V eps = Splat(params_.eps);
