@@ -295,12 +295,16 @@ class Walls {
       const V w = read(kInvLength2);
       const V ay_aby = read(kAyAby);
       const lane::vec2 ap(px - ax, py - ay), ab(abx, aby);
-      const V d2 = lane::segment_distance2(ap, ab, w).v;
-      const M nearest = hn::And(valid, d2 < best);
-      second = Select(nearest, best, Select(hn::And(valid, d2 < second), d2, second));
-      best = Select(nearest, d2, best);
-      edge = Select(nearest, SplatI(k), edge);
-      inside = hn::Xor(inside, hn::And(valid, lane::crosses(py, ay, ay_aby, ap, ab).m));
+      V d2 = lane::segment_distance2(ap, ab, w).v;
+      // As in wall_distance: lanes without edge k masked only where rooms differ in edge
+      // count, the least two by min and max.
+      const bool every_lane = kOneRoom || same_count_;
+      if (!every_lane) d2 = Select(valid, d2, Splat(kFar));
+      edge = Select(d2 < best, SplatI(k), edge);
+      second = hn::Min(hn::Max(d2, best), second);
+      best = hn::Min(d2, best);
+      const M crosses = lane::crosses(py, ay, ay_aby, ap, ab).m;
+      inside = hn::Xor(inside, every_lane ? crosses : hn::And(valid, crosses));
     }
     WallDistance w;
     const V root = hn::Sqrt(best);
