@@ -13,6 +13,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <stdexcept>
 
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/packet.hpp"
@@ -395,6 +396,16 @@ TEST(Simd, AnUnknownInstructionSetIsUnavailableAndSaysWhy) {
   EXPECT_FALSE(unknown.availability().available);
   EXPECT_NE(unknown.availability().reason.find("unknown"), std::string::npos);
   EXPECT_THROW(unknown.render(scene, scene.camera, 8, 8, {}, {}), std::runtime_error);
+}
+
+TEST(Simd, RefusesAFrameOfMorePixelsThanItsLanesCanNumber) {
+  const Scene& scene = test::gallery_scene("torus");
+  const SimdBackend simd;
+  if (!simd.availability().available) GTEST_SKIP() << simd.availability().reason;
+  EXPECT_THROW(simd.render(scene, scene.camera, -1, 8, {}, {}), std::invalid_argument);
+  // 2^31 pixels: refused before the frame's memory is asked for.
+  EXPECT_THROW(simd.render(scene, scene.camera, 65536, 32768, {}, {}), std::invalid_argument);
+  EXPECT_EQ(simd.render(scene, scene.camera, 1, 1, {}, {}).hit.size(), 1u);
 }
 
 TEST(CliSimd, IsTheDefaultOfRenderAndTakesItsOptions) {

@@ -81,6 +81,26 @@ HWY_INLINE M Select(M m, M a, M b) {
 HWY_INLINE bool Any(M m) {
   return !hn::AllFalse(D(), m);
 }
+// The lanes of `m` as bits, lane l in bit l.
+HWY_INLINE uint64_t Bits(M m) {
+  uint8_t bytes[8] = {};
+  hn::StoreMaskBits(D(), m, bytes);
+  uint64_t bits = 0;
+  for (size_t b = 0; b < 8; ++b) bits |= uint64_t{bytes[b]} << (8 * b);
+  return bits;
+}
+// Each lane of `m`: how many lanes of `m` are below it (the other lanes: any number).
+HWY_INLINE VI Rank(M m) {
+  const DI di;
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+  if constexpr (hn::MaxLanes(di) == 16)  // one instruction: the lane numbers expanded into `m`
+    return VI{_mm512_maskz_expand_epi32(m.raw, hn::Iota(di, 0).raw)};
+#endif
+  const hn::RebindToUnsigned<DI> du;
+  const auto below = (hn::Set(du, 1u) << hn::Iota(du, 0)) - hn::Set(du, 1u);
+  const auto bits = hn::Set(du, static_cast<uint32_t>(Bits(m)));
+  return hn::BitCast(di, hn::PopulationCount(hn::And(bits, below)));
+}
 
 // Entry `index` of `table` for each lane, the table held in `vectors` vectors, one or two: in
 // two, a lookup in each and the lane's own kept.

@@ -11,9 +11,11 @@
 #include <chrono>
 #include <condition_variable>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <utility>
 
@@ -177,6 +179,10 @@ Frame SimdBackend::render_counted(const Scene& scene, const Camera& camera, int 
                                   const MarchParams& params, const Progress& progress,
                                   simd::LaneCounts& lanes) const {
   check_precision(params);
+  // The packets hold each lane's pixel's index in a 32-bit lane.
+  if (width < 0 || height < 0 || int64_t{width} * height > std::numeric_limits<int32_t>::max())
+    throw std::invalid_argument("the simd backend renders frames of up to 2^31 - 1 pixels, not " +
+                                std::to_string(width) + "x" + std::to_string(height));
   const simd::PacketCode packets = code();
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   Frame frame(width, height);
