@@ -124,9 +124,15 @@ KINLINE real edge_parameter(vec2 p, vec2 a, vec2 ab, real w) {
   return dot(p - a, ab) * w;
 }
 
-// Whether the parameter u is on its edge, to within `tolerance` of its ends.
+// Whether the parameter u lies in [low, high].
+KINLINE lane_bool on_edge_within(real u, real low, real high) {
+  return u >= low && u <= high;
+}
+
+// Whether the parameter u is on its edge, to within `tolerance` of its ends. (The SIMD backend
+// reads 1 + tolerance from a table, worked out once per edge, and calls on_edge_within.)
 KINLINE lane_bool on_edge(real u, real tolerance) {
-  return u >= -tolerance && u <= real(1) + tolerance;
+  return on_edge_within(u, -tolerance, real(1) + tolerance);
 }
 
 // Whether the parameter u is within `tolerance` of an end of its edge: the ray leaves by a vertex.

@@ -419,10 +419,11 @@ PacketJob packet_job(const kernel::SceneTables<float>& tables) {
   job.tables = &tables;
   for (const auto& e : tables.edges) {
     const float abx = e.segment.z - e.segment.x, aby = e.segment.w - e.segment.y;
-    job.edge_extra.emplace_back(abx, aby, tables.params.vertex_tolerance * std::sqrt(e.line.w),
-                                e.segment.y + aby);
+    const float tolerance = tables.params.vertex_tolerance * std::sqrt(e.line.w);
+    job.edge_extra.emplace_back(abx, aby, tolerance, e.segment.y + aby);
+    job.edge_high.push_back(1.0f + tolerance);
   }
-  job.edges = edge_tables(tables, job.edge_extra);
+  job.edges = edge_tables(tables, job.edge_extra, job.edge_high);
   // The scene compiler marks every edge (link.w) where every room is convex.
   job.exit_by_nearest_line = tables.params.method == kMethodAnalytic &&
                              tables.polygons.size() > 1 && !job.edges.same_rooms &&

@@ -25,6 +25,9 @@ struct PacketJob {
   // Per edge of tables->edges, what the packets would otherwise recompute per step: b - a (x, y),
   // the vertex tolerance in units of the edge parameter (z), a.y + (b - a).y (w).
   std::vector<glm::vec4> edge_extra;
+  // And 1 + that tolerance, the edge parameter's upper bound (maths.glsl's on_edge): a number
+  // read where the exit edge's loop added it once per edge tested.
+  std::vector<float> edge_high;
   EdgeTables edges;  // the edges' numbers and gluings as the packets read them
   // The analytic method's whole passes find their exit edge by the nearest line first (the same
   // exit: nearest-inl.h): in scenes of several convex rooms not alike, where it saves work.
@@ -38,7 +41,7 @@ struct PacketJob {
   Frame* frame = nullptr;
 };
 
-// A job on `tables` with its edge_extra and edges filled in (no frame).
+// A job on `tables` with its edge_extra, edge_high and edges filled in (no frame).
 PacketJob packet_job(const kernel::SceneTables<float>& tables);
 
 // The job of a frame of `tables` seen from `camera`, drawn into `frame`: packet_job, the

@@ -38,6 +38,7 @@ class Walls {
       : polygons_(job.tables->polygons.data()),
         edges_(job.tables->edges.data()),
         extra_(job.edge_extra.data()),
+        high_(job.edge_high.data()),
         params_(job.tables->params),
         features_(job.tables->features),
         convex_(!job.tables->edges.empty() && job.tables->edges[0].link.w != 0) {
@@ -193,7 +194,8 @@ class Walls {
   // the scene's edge numbers (lookup_).
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
-    if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
+    if constexpr (kOneRoom)
+      return Splat(edge_number(f, edges_[at.edge], extra_[at.edge], high_[at.edge]));
     if (same_rooms_) return Splat(lookup_[f][static_cast<size_t>(same_first_edge_ + at.k)]);
     if (at.k < kAlikeSlots && ((alike_[f] >> at.k) & 1u) != 0u)
       return Splat(alike_number_[f][static_cast<size_t>(at.k)]);
@@ -321,20 +323,22 @@ class Walls {
     x.s = Splat(kFar);
     x.edge = SplatI(-1);
     V u_exit = Splat(0.5f), tolerance_exit = Splat(0.0f);  // of the exit edge found so far
-    const V vertex_tolerance = Splat(params_.vertex_tolerance);
+    const V least = Splat(-params_.vertex_tolerance);
     const lane::vec2 o(ox, oy), dh(dhx, dhy);
+    // In one room every lane of the pass has each edge.
+    const M open = kOneRoom ? hn::And(m, rooms.lanes[0]) : m;
     for (int k = 0; k < rooms.most_edges; ++k) {
       const Slot at = slot<kOneRoom>(rooms, k);
       const lane::vec2 n(field<kOneRoom>(at, kNx), field<kOneRoom>(at, kNy));
       const V dn = lane::dot(dh, n).v;
-      const M towards = hn::And(hn::And(m, at.valid), dn > Splat(0.0f));
+      const M towards = hn::And(kOneRoom ? open : hn::And(open, at.valid), dn > Splat(0.0f));
       if (!Any(towards)) continue;
       const V nz = field<kOneRoom>(at, kNa);
       const V s = lane::line_distance(o, n, nz, dn).v;
       // No test whether any ray meets this edge's line before its exit so far: the branch
       // mispredicts in packets whose rays are at different steps of their march (with it, the
       // analytic frames were 2-6% slower).
-      M ok = hn::AndNot(hn::Or(s < hn::Neg(vertex_tolerance), s >= x.s), towards);
+      M ok = hn::AndNot(hn::Or(s < least, s >= x.s), towards);
       const V ax = field<kOneRoom>(at, kAx);
       const V ay = field<kOneRoom>(at, kAy);
       const V abx = field<kOneRoom>(at, kAbx);
@@ -344,7 +348,7 @@ class Walls {
           lane::edge_parameter(o + lane::real(s) * dh, lane::vec2(ax, ay), lane::vec2(abx, aby), w)
               .v;
       const V tolerance = field<kOneRoom>(at, kTolerance);
-      ok = hn::And(ok, lane::on_edge(u, tolerance).m);
+      ok = hn::And(ok, lane::on_edge_within(u, hn::Neg(tolerance), field<kOneRoom>(at, kHigh)).m);
       x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
       x.edge = Select(ok, SplatI(k), x.edge);
       u_exit = Select(ok, u, u_exit);
@@ -421,6 +425,7 @@ class Walls {
   const ivec4* polygons_;
   const EdgeRecord* edges_;
   const glm::vec4* extra_;  // per edge: b - a (x, y), vertex tolerance in u (z), a.y + (b - a).y
+  const float* high_;       // per edge: 1 + that tolerance
   // The tables are arrays in the object, not on the heap: with std::vector the frames of the
   // torus and the L-shape, which never read them, were 10-20% slower (measured).
   static constexpr size_t kMostEdges = 512;
