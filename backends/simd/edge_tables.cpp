@@ -62,13 +62,13 @@ void slot_gluings(const kernel::SceneTables<float>& tables, EdgeTables& t) {
 }  // namespace
 
 EdgeTables edge_tables(const kernel::SceneTables<float>& tables,
-                       const std::vector<glm::vec4>& extra, const std::vector<float>& high) {
+                       const std::vector<glm::vec4>& extra) {
   EdgeTables t;
   const size_t edges = tables.edges.size();
   for (size_t f = 0; f < kFields; ++f) {
     t.number[f].resize(edges);
     for (size_t e = 0; e < edges; ++e)
-      t.number[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], extra[e], high[e]);
+      t.number[f][e] = edge_number(static_cast<Field>(f), tables.edges[e], extra[e]);
   }
   for (const ivec4& p : tables.polygons) t.most_edges = std::max(t.most_edges, p.y);
   // Number f of edge k, where every room that has an edge k holds the same.

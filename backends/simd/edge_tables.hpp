@@ -16,24 +16,10 @@
 namespace flatmarch::simd {
 
 // The numbers of an edge the packet code reads, by name.
-enum Field {
-  kAx,
-  kAy,
-  kAbx,
-  kAby,
-  kAyAby,
-  kNx,
-  kNy,
-  kNa,
-  kInvLength2,
-  kTolerance,
-  kHigh,  // 1 + kTolerance: the edge parameter's upper bound (on_edge_within)
-  kFields
-};
+enum Field { kAx, kAy, kAbx, kAby, kAyAby, kNx, kNy, kNa, kInvLength2, kTolerance, kFields };
 
-// Number `f` of edge `e`, whose edge_extra and edge_high (packet.hpp) are `extra` and `high`.
-inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra,
-                         float high) {
+// Number `f` of edge `e`, whose edge_extra (packet.hpp) is `extra`.
+inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, glm::vec4 extra) {
   switch (f) {
     case kAx:
       return e.segment.x;
@@ -55,8 +41,6 @@ inline float edge_number(Field f, const kernel::Tables<float>::EdgeRecord& e, gl
       return e.line.w;
     case kTolerance:
       return extra.z;
-    case kHigh:
-      return high;
     case kFields:
       break;
   }
@@ -102,8 +86,8 @@ struct EdgeTables {
   std::vector<glm::vec4> tints;    // the tints slot_code numbers
 };
 
-// The edge tables of `tables`, whose edges' edge_extra and edge_high are `extra` and `high`.
+// The edge tables of `tables`, whose edges' edge_extra is `extra`.
 EdgeTables edge_tables(const kernel::SceneTables<float>& tables,
-                       const std::vector<glm::vec4>& extra, const std::vector<float>& high);
+                       const std::vector<glm::vec4>& extra);
 
 }  // namespace flatmarch::simd

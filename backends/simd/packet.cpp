@@ -423,7 +423,7 @@ PacketJob packet_job(const kernel::SceneTables<float>& tables) {
     job.edge_extra.emplace_back(abx, aby, tolerance, e.segment.y + aby);
     job.edge_high.push_back(1.0f + tolerance);
   }
-  job.edges = edge_tables(tables, job.edge_extra, job.edge_high);
+  job.edges = edge_tables(tables, job.edge_extra);
   // The scene compiler marks every edge (link.w) where every room is convex.
   job.exit_by_nearest_line = tables.params.method == kMethodAnalytic &&
                              tables.polygons.size() > 1 && !job.edges.same_rooms &&

@@ -25,8 +25,8 @@ struct PacketJob {
   // Per edge of tables->edges, what the packets would otherwise recompute per step: b - a (x, y),
   // the vertex tolerance in units of the edge parameter (z), a.y + (b - a).y (w).
   std::vector<glm::vec4> edge_extra;
-  // And 1 + that tolerance, the edge parameter's upper bound (maths.glsl's on_edge): a number
-  // read where the exit edge's loop added it once per edge tested.
+  // And 1 + that tolerance, the edge parameter's upper bound (maths.glsl's on_edge): read by a
+  // room's own exit-edge loop, which added it once per edge tested.
   std::vector<float> edge_high;
   EdgeTables edges;  // the edges' numbers and gluings as the packets read them
   // The analytic method's whole passes find their exit edge by the nearest line first (the same

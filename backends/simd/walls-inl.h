@@ -194,8 +194,7 @@ class Walls {
   // the scene's edge numbers (lookup_).
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE V field(const Slot& at, Field f) const {
-    if constexpr (kOneRoom)
-      return Splat(edge_number(f, edges_[at.edge], extra_[at.edge], high_[at.edge]));
+    if constexpr (kOneRoom) return Splat(edge_number(f, edges_[at.edge], extra_[at.edge]));
     if (same_rooms_) return Splat(lookup_[f][static_cast<size_t>(same_first_edge_ + at.k)]);
     if (at.k < kAlikeSlots && ((alike_[f] >> at.k) & 1u) != 0u)
       return Splat(alike_number_[f][static_cast<size_t>(at.k)]);
@@ -348,7 +347,9 @@ class Walls {
           lane::edge_parameter(o + lane::real(s) * dh, lane::vec2(ax, ay), lane::vec2(abx, aby), w)
               .v;
       const V tolerance = field<kOneRoom>(at, kTolerance);
-      ok = hn::And(ok, lane::on_edge_within(u, hn::Neg(tolerance), field<kOneRoom>(at, kHigh)).m);
+      // on_edge, its upper bound read in one room (job.edge_high), not added for every edge.
+      const V high = kOneRoom ? Splat(high_[at.edge]) : Splat(1.0f) + tolerance;
+      ok = hn::And(ok, lane::on_edge_within(u, hn::Neg(tolerance), high).m);
       x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
       x.edge = Select(ok, SplatI(k), x.edge);
       u_exit = Select(ok, u, u_exit);
