@@ -36,6 +36,41 @@ HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
 
+// Of a pair of opposite slots k and j (Walls::opposite_pairs), the one a ray of `m` moves
+// towards, if any: its slot, its line's distance s, and whether it counts as the first edge of
+// the nearest-line loop below would count it (moved towards, s >= least, s < kFar). `base`: the
+// same without s < kFar, for an edge tested after another.
+struct PairEdge {
+  VI slot;
+  V s;
+  M base, first;
+};
+FLATMARCH_PACKET_INLINE PairEdge TowardsOfPair(const Walls& walls, M m, const Rooms& rooms, int k,
+                                               int j, V least, const lane::vec2& o,
+                                               const lane::vec2& dh) {
+  const Walls::Slot at_k = walls.slot<false>(rooms, k), at_j = walls.slot<false>(rooms, j);
+  // The normals are alike in every room (broadcasts), and slot j's is slot k's negated: where
+  // a ray moves towards edge k it moves away from edge j, and where it does not towards k, its
+  // numbers for j are j's own. So the pair costs one line's distance, not two.
+  const V nkx = walls.field<false>(at_k, kNx), nky = walls.field<false>(at_k, kNy);
+  const M take_k = lane::dot(dh, lane::vec2(nkx, nky)).v > Splat(0.0f);
+  const lane::vec2 n(Select(take_k, nkx, walls.field<false>(at_j, kNx)),
+                     Select(take_k, nky, walls.field<false>(at_j, kNy)));
+  PairEdge e;
+  e.slot = Select(take_k, SplatI(k), SplatI(j));
+  Walls::Slot at;  // the lane's edge, looked up by lane (a slot number past those read alike)
+  at.edge = 0;
+  at.k = kAlikeSlots;
+  at.rooms = &rooms;
+  at.valid = m;
+  at.edges = Select(m, rooms.first_edge + e.slot, SplatI(0));
+  const V dn = lane::dot(dh, n).v;
+  e.s = lane::line_distance(o, n, walls.field<false>(at, kNa), dn).v;
+  e.base = hn::AndNot(e.s < least, hn::And(m, dn > Splat(0.0f)));
+  e.first = hn::AndNot(e.s >= Splat(kFar), e.base);
+  return e;
+}
+
 // Walls::exit_edge<false> for the rays of `m` in a whole pass whose edges are looked up by lane
 // (Walls::glue_by_lane, not Walls::same_rooms).
 FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Rooms& rooms,
@@ -44,7 +79,26 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
   const V least = Splat(-vertex_tolerance);
   V s_exit = Splat(kFar), s_line = Splat(0.0f);
   VI k_exit = SplatI(-1);
-  for (int k = 0; k < rooms.most_edges; ++k) {
+  if (walls.opposite_pairs()) {
+    // Rooms of four edges in two opposite pairs (0, 2) and (1, 3): the loop below would find
+    // each lane one edge of each pair it moves towards, a and b, and take them in slot order.
+    // Both are found at once, and the order applied lane by lane: where b's slot comes first,
+    // a is tested after b, else b after a (an edge tested second replaces the first exactly
+    // when the loop's test passes against the first's max(s, 0)).
+    const PairEdge a = TowardsOfPair(walls, m, rooms, 0, 2, least, o, dh);
+    const PairEdge b = TowardsOfPair(walls, m, rooms, 1, 3, least, o, dh);
+    const V a_exit = Select(a.first, hn::Max(a.s, Splat(0.0f)), Splat(kFar));
+    const V b_exit = Select(b.first, hn::Max(b.s, Splat(0.0f)), Splat(kFar));
+    const M a_after_b = hn::AndNot(a.s >= b_exit, a.base);  // a, tested after b, replaces it
+    const M b_after_a = hn::AndNot(b.s >= a_exit, b.base);  // b, tested after a, replaces it
+    const M b_first = hn::RebindMask(D(), b.slot < a.slot);
+    const M take_b = Select(b_first, hn::AndNot(a_after_b, b.first), b_after_a);
+    const M take_a = hn::AndNot(take_b, Select(b_first, a_after_b, a.first));
+    s_exit = Select(take_b, b_exit, Select(take_a, a_exit, s_exit));
+    s_line = Select(take_b, b.s, Select(take_a, a.s, s_line));
+    k_exit = Select(take_b, b.slot, Select(take_a, a.slot, k_exit));
+  }
+  for (int k = 0; k < rooms.most_edges && !walls.opposite_pairs(); ++k) {
     const Walls::Slot at = walls.slot<false>(rooms, k);
     const lane::vec2 n(walls.field<false>(at, kNx), walls.field<false>(at, kNy));
     const V dn = lane::dot(dh, n).v;

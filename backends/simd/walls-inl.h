@@ -91,6 +91,13 @@ class Walls {
     for (size_t f = 0; f < kGlueFields; ++f) copy(glue_[f], t.glue[f]);
     glue_alike_ = t.glue_alike;
     glue_number_ = t.glue_number;
+    const auto opposite = [&](size_t k, size_t j) {
+      const uint32_t both = (1u << k) | (1u << j);
+      return (alike_[kNx] & both) == both && (alike_[kNy] & both) == both &&
+             alike_number_[kNx][j] == -alike_number_[kNx][k] &&
+             alike_number_[kNy][j] == -alike_number_[kNy][k];
+    };
+    opposite_pairs_ = most_edges_ == 4 && same_count_ && opposite(0, 2) && opposite(1, 3);
   }
 
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
@@ -138,6 +145,10 @@ class Walls {
     if (mode_ == kTable || (same_rooms_ && !has(kFeatureWalls))) return true;
     return !analytic && held_ && !has(kFeatureWalls);
   }
+  // Whether every room has four edges whose normals are alike in every room, slot 2's slot 0's
+  // negated and slot 3's slot 1's (parallelograms drawn alike: the cube's faces, squares): a
+  // ray moves towards one edge of each pair at most (ExitByNearestLine).
+  bool opposite_pairs() const { return opposite_pairs_; }
   // Whether the rooms are alike in every number a step reads (each edge's numbers the same in
   // every room): lanes need not hold their edges.
   bool same_rooms() const { return same_rooms_; }
@@ -455,7 +466,8 @@ class Walls {
   std::array<Table<float>, kGlueFields> glue_;
   uint32_t glue_alike_ = 0;  // bit f: number f of glue_ alike at every glued edge, glue_number_[f]
   std::array<float, kGlueFields> glue_number_{};
-  bool same_count_ = false;  // every room has most_edges_ edges
+  bool same_count_ = false;      // every room has most_edges_ edges
+  bool opposite_pairs_ = false;  // opposite_pairs()
   Table<int32_t> to_polygon_, first_edge_, edge_count_;
   Table<int32_t> wall_;  // of each edge: -1 an opaque wall, else 0
   SlotGluings by_slot_;  // glue_by_slot()
