@@ -133,7 +133,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
   Exit x;
   x.s = Select(on, s_exit, Splat(kFar));
   x.edge = Select(on, k_exit, SplatI(-1));
-  x.corner = lane::near_end(Select(on, u, Splat(0.5f)), Select(on, tolerance, Splat(0.0f))).m;
+  x.corner = hn::And(on, lane::near_end(u, tolerance).m);
   // Lanes with no edge found have the full loop's answer already (it finds none either).
   const M rest = hn::AndNot(on, hn::And(m, found));
   if (Any(rest)) {
