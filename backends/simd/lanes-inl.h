@@ -167,6 +167,9 @@ struct Exit {
   V s;
   VI edge;
   M corner;
+  // The component of the ray's direction along the edge's normal (its dn): the tint of the
+  // crossing reads it, and the direction does not change before it (a room segment).
+  V cosine;
 };
 
 struct SolidDistance {

@@ -65,7 +65,7 @@ class Marcher : private RayEvents {
     r.done = hn::Not(None());
     x.omega = x.last_radius = x.last_step = Splat(0.0f);
     seg.known = seg.exit.corner = None();
-    seg.exit.s = seg.solids = Splat(0.0f);
+    seg.exit.s = seg.exit.cosine = seg.solids = Splat(0.0f);
     seg.exit.edge = SplatI(-1);
   }
 
@@ -274,6 +274,7 @@ class Marcher : private RayEvents {
       seg.exit.s = Select(unknown, x.s, seg.exit.s);
       seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
       seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
+      seg.exit.cosine = Select(unknown, x.cosine, seg.exit.cosine);
       if (has(kFeatureObjects))
         seg.solids = Select(unknown, solids_.solid_entry(rooms, r), seg.solids);
       else
@@ -318,7 +319,7 @@ class Marcher : private RayEvents {
     rest = hn::AndNot(wall, rest);
     if (Any(rest)) {
       advance(r, rest, seg.exit.s);
-      cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f));
+      cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f), &seg.exit.cosine);
       seg.known = hn::AndNot(rest, seg.known);
     }
   }

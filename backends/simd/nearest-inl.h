@@ -42,7 +42,7 @@ namespace HWY_NAMESPACE {
 // same without s < kFar, for an edge tested after another.
 struct PairEdge {
   VI slot;
-  V s;
+  V s, dn;
   M base, first;
 };
 FLATMARCH_PACKET_INLINE PairEdge TowardsOfPair(const Walls& walls, M m, const Rooms& rooms, int k,
@@ -64,9 +64,9 @@ FLATMARCH_PACKET_INLINE PairEdge TowardsOfPair(const Walls& walls, M m, const Ro
   at.rooms = &rooms;
   at.valid = m;
   at.edges = Select(m, rooms.first_edge + e.slot, SplatI(0));
-  const V dn = lane::dot(dh, n).v;
-  e.s = lane::line_distance(o, n, walls.field<false>(at, kNa), dn).v;
-  e.base = hn::AndNot(e.s < least, hn::And(m, dn > Splat(0.0f)));
+  e.dn = lane::dot(dh, n).v;
+  e.s = lane::line_distance(o, n, walls.field<false>(at, kNa), e.dn).v;
+  e.base = hn::AndNot(e.s < least, hn::And(m, e.dn > Splat(0.0f)));
   e.first = hn::AndNot(e.s >= Splat(kFar), e.base);
   return e;
 }
@@ -77,7 +77,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
                                                float vertex_tolerance, V ox, V oy, V dhx, V dhy) {
   const lane::vec2 o(ox, oy), dh(dhx, dhy);
   const V least = Splat(-vertex_tolerance);
-  V s_exit = Splat(kFar), s_line = Splat(0.0f);
+  V s_exit = Splat(kFar), s_line = Splat(0.0f), cosine = Splat(0.0f);
   VI k_exit = SplatI(-1);
   if (walls.opposite_pairs()) {
     // Rooms of four edges in two opposite pairs (0, 2) and (1, 3): the loop below would find
@@ -97,6 +97,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
     s_exit = Select(take_b, b_exit, Select(take_a, a_exit, s_exit));
     s_line = Select(take_b, b.s, Select(take_a, a.s, s_line));
     k_exit = Select(take_b, b.slot, Select(take_a, a.slot, k_exit));
+    cosine = Select(take_b, b.dn, Select(take_a, a.dn, cosine));
   }
   for (int k = 0; k < rooms.most_edges && !walls.opposite_pairs(); ++k) {
     const Walls::Slot at = walls.slot<false>(rooms, k);
@@ -112,6 +113,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
     s_exit = Select(ok, hn::Max(s, Splat(0.0f)), s_exit);
     s_line = Select(ok, s, s_line);
     k_exit = Select(ok, SplatI(k), k_exit);
+    cosine = Select(ok, dn, cosine);
   }
   // The edge found, each lane's own: its numbers looked up by lane (a slot number past those
   // read alike by slot, so that field() looks every number up).
@@ -134,6 +136,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
   x.s = Select(on, s_exit, Splat(kFar));
   x.edge = Select(on, k_exit, SplatI(-1));
   x.corner = hn::And(on, lane::near_end(u, tolerance).m);
+  x.cosine = cosine;
   // Lanes with no edge found have the full loop's answer already (it finds none either).
   const M rest = hn::AndNot(on, hn::And(m, found));
   if (Any(rest)) {
@@ -141,6 +144,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
     x.s = Select(rest, full.s, x.s);
     x.edge = Select(rest, full.edge, x.edge);
     x.corner = hn::Or(hn::AndNot(rest, x.corner), hn::And(rest, full.corner));
+    x.cosine = Select(rest, full.cosine, x.cosine);
   }
   return x;
 }

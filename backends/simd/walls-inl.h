@@ -332,6 +332,7 @@ class Walls {
     Exit x;
     x.s = Splat(kFar);
     x.edge = SplatI(-1);
+    x.cosine = Splat(0.0f);
     V u_exit = Splat(0.5f), tolerance_exit = Splat(0.0f);  // of the exit edge found so far
     const V least = Splat(-params_.vertex_tolerance);
     const lane::vec2 o(ox, oy), dh(dhx, dhy);
@@ -363,6 +364,7 @@ class Walls {
       ok = hn::And(ok, lane::on_edge_within(u, hn::Neg(tolerance), high).m);
       x.s = Select(ok, hn::Max(s, Splat(0.0f)), x.s);
       x.edge = Select(ok, SplatI(k), x.edge);
+      x.cosine = Select(ok, dn, x.cosine);
       u_exit = Select(ok, u, u_exit);
       tolerance_exit = Select(ok, tolerance, tolerance_exit);
     }
@@ -411,14 +413,15 @@ class Walls {
   // The rays of `m` go through their edge `edge` (glued; its index in the edge table) into the
   // glued room and are placed `push` inside the edge they are then behind: march.glsl's
   // cross_edge when every edge is glued and the scene's edges fit in a vector (merge()), each
-  // lane looking its edge's gluing up (glue_), all in one round. The caller records the event.
-  FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push) const {
+  // lane looking its edge's gluing up (glue_), all in one round. `cosine`: the rays' component
+  // along the edges' normals where known (Exit::cosine), else null. The caller records the event.
+  FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push, const V* cosine) const {
     const VI at = Select(m, edge, SplatI(0));
     const auto glue = [&](size_t f) FLATMARCH_PACKET_LAMBDA {
       return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
     };
     const lane::vec4 tint{glue(11), glue(12), glue(13), glue(14)};
-    GlueRays(r, m, params_, features_, glue, tint, lookup(DI(), to_polygon_, at), push);
+    GlueRays(r, m, params_, features_, glue, tint, lookup(DI(), to_polygon_, at), push, cosine);
   }
 
   // Whether crossings read each lane's gluing by its slot (EdgeTables::glue_by_slot), in scenes
@@ -427,8 +430,9 @@ class Walls {
   bool glue_by_slot() const { return by_slot_.on(); }
   // The rays of `m` go through their edge `edge` (glued; its slot in their room), as
   // cross_glued.
-  FLATMARCH_PACKET_INLINE void cross_by_slot(Packet& r, M m, VI edge, V push) const {
-    by_slot_.cross(r, m, edge, push, params_, features_);
+  FLATMARCH_PACKET_INLINE void cross_by_slot(Packet& r, M m, VI edge, V push,
+                                             const V* cosine) const {
+    by_slot_.cross(r, m, edge, push, params_, features_, cosine);
   }
 
  private:
