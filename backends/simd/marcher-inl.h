@@ -128,7 +128,7 @@ class Marcher : private RayEvents {
         count_lanes(lanes, pending);
         // Three calls, so that each inlined copy knows whether it reads held edges.
         if (analytic)
-          analytic_step<false, kNearest>(r, seg, pending, rooms);
+          analytic_step<false, kNearest, kNearest>(r, seg, pending, rooms);
         else if (hold)
           sphere_step<false>(r, x, pending, rooms, &held);
         else
@@ -166,11 +166,11 @@ class Marcher : private RayEvents {
       rooms.all = pass;
       count_lanes(lanes, pass);
       if (rooms.count == 1 && analytic) {
-        analytic_step<true>(r, seg, pass, rooms);
+        analytic_step<true, false, kNearest>(r, seg, pass, rooms);
       } else if (rooms.count == 1) {
         sphere_step<true>(r, x, pass, rooms, nullptr);
       } else if (analytic) {
-        analytic_step<false>(r, seg, pass, rooms);
+        analytic_step<false, false, kNearest>(r, seg, pass, rooms);
       } else {
         sphere_step<false>(r, x, pass, rooms, nullptr);
       }
@@ -261,8 +261,10 @@ class Marcher : private RayEvents {
     seg.solids = Select(m, hn::Max(seg.solids - s, Splat(0.0f)), seg.solids);
   }
 
-  // One iteration of the analytic method for the rays of `m`, in `rooms` (kNearest: step's).
-  template <bool kOneRoom, bool kNearest = false>
+  // One iteration of the analytic method for the rays of `m`, in `rooms`. kNearest: the exit by
+  // the nearest line (step's); kCarry: the step's copy (step<true>), where a crossing reads its
+  // tint's cosine from the exit (Exit::cosine), whatever pass found it.
+  template <bool kOneRoom, bool kNearest = false, bool kCarry = false>
   FLATMARCH_PACKET_INLINE void analytic_step(Packet& r, Segment& seg, M m,
                                              const Rooms& rooms) const {
     const M unknown = hn::AndNot(seg.known, m);
@@ -274,7 +276,7 @@ class Marcher : private RayEvents {
       seg.exit.s = Select(unknown, x.s, seg.exit.s);
       seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
       seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
-      seg.exit.cosine = Select(unknown, x.cosine, seg.exit.cosine);
+      if (kCarry) seg.exit.cosine = Select(unknown, x.cosine, seg.exit.cosine);
       if (has(kFeatureObjects))
         seg.solids = Select(unknown, solids_.solid_entry(rooms, r), seg.solids);
       else
@@ -319,7 +321,10 @@ class Marcher : private RayEvents {
     rest = hn::AndNot(wall, rest);
     if (Any(rest)) {
       advance(r, rest, seg.exit.s);
-      cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f), &seg.exit.cosine);
+      // The exit's cosine carried in the nearest line's copy alone (MarchPacketsWith<true>):
+      // carried in the other, its sphere and relaxed tracing, which never read it, were
+      // 1.02-1.04x slower.
+      cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f), kCarry ? &seg.exit.cosine : nullptr);
       seg.known = hn::AndNot(rest, seg.known);
     }
   }
