@@ -37,9 +37,9 @@ namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
 
 // Of a pair of opposite slots k and j (Walls::opposite_pairs), the one a ray of `m` moves
-// towards, if any: its slot, its line's distance s, and whether it counts as the first edge of
-// the nearest-line loop below would count it (moved towards, s >= least, s < kFar). `base`: the
-// same without s < kFar, for an edge tested after another.
+// towards, if any: its slot, its line's distance s, its dn, and whether the nearest-line loop
+// below would take it as the first edge it tests (`first`: moved towards, s >= least, s < kFar)
+// or as one tested after another (`base`: the same without s < kFar).
 struct PairEdge {
   VI slot;
   V s, dn;
