@@ -73,19 +73,22 @@ class RayEvents {
   // reflected, and are placed `push` inside the edge they are then behind. In one round where
   // each lane's gluing can be looked up (by its edge, Walls::cross_glued; by its slot,
   // Walls::cross_by_slot); else one broadcast record per edge crossed. `carried`: where not null,
-  // the rays' component along their edges' normals (Exit::cosine), for the one-round crossings.
+  // the exit the rays found for `edge` (its cosine and index), for the one-round crossings.
   FLATMARCH_PACKET_INLINE void cross_edge(Packet& r, M m, const Rooms& rooms, VI edge, V push,
-                                          const V* carried = nullptr) const {
+                                          const Exit* carried = nullptr) const {
     const bool by_lane = walls_.glue_by_lane() && !has(kFeatureMirrors);
     if (by_lane || walls_.glue_by_slot()) {
       if (events_ && !hn::AllFalse(D(), hn::And(m, hn::FirstN(D(), 1)))) {
         const ivec4 link = edges_[polygons_[hn::GetLane(r.polygon)].x + hn::GetLane(edge)].link;
         record(m, kEventGluing, r.polygon, edge, link.y, link.z, SplatI(-1), r);
       }
-      if (by_lane)
-        walls_.cross_glued(r, m, rooms.first_edge + edge, push, carried);
+      const V* cosine = carried ? &carried->cosine : nullptr;
+      if (by_lane && carried)
+        walls_.cross_glued<true>(r, m, carried->index, push, cosine);
+      else if (by_lane)
+        walls_.cross_glued<false>(r, m, rooms.first_edge + edge, push, cosine);
       else
-        walls_.cross_by_slot(r, m, edge, push, carried);
+        walls_.cross_by_slot(r, m, edge, push, cosine);
       return;
     }
     std::array<int32_t, hn::MaxLanes(DI())> lane_edges{}, lane_rooms{};

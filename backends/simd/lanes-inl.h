@@ -170,6 +170,9 @@ struct Exit {
   // The component of the ray's direction along the edge's normal (its dn): the tint of the
   // crossing reads it, and the direction does not change before it (a room segment).
   V cosine;
+  // The edge's index in the edge table (its room's first edge plus `edge`), 0 where none: the
+  // crossing's lookups by it need not wait for the tests that settle `edge`.
+  VI index;
 };
 
 struct SolidDistance {

@@ -67,6 +67,7 @@ class Marcher : private RayEvents {
     seg.known = seg.exit.corner = None();
     seg.exit.s = seg.exit.cosine = seg.solids = Splat(0.0f);
     seg.exit.edge = SplatI(-1);
+    seg.exit.index = SplatI(0);
   }
 
   // The start of march.glsl's march(): the lanes of `m` begin a ray from (fx, fy, fz) in
@@ -276,7 +277,10 @@ class Marcher : private RayEvents {
       seg.exit.s = Select(unknown, x.s, seg.exit.s);
       seg.exit.edge = Select(unknown, x.edge, seg.exit.edge);
       seg.exit.corner = Select(unknown, x.corner, seg.exit.corner);
-      if (kCarry) seg.exit.cosine = Select(unknown, x.cosine, seg.exit.cosine);
+      if (kCarry) {
+        seg.exit.cosine = Select(unknown, x.cosine, seg.exit.cosine);
+        seg.exit.index = Select(unknown, x.index, seg.exit.index);
+      }
       if (has(kFeatureObjects))
         seg.solids = Select(unknown, solids_.solid_entry(rooms, r), seg.solids);
       else
@@ -324,7 +328,7 @@ class Marcher : private RayEvents {
       // The exit's cosine carried in the nearest line's copy alone (MarchPacketsWith<true>):
       // carried in the other, its sphere and relaxed tracing, which never read it, were
       // 1.02-1.04x slower.
-      cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f), kCarry ? &seg.exit.cosine : nullptr);
+      cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f), kCarry ? &seg.exit : nullptr);
       seg.known = hn::AndNot(rest, seg.known);
     }
   }

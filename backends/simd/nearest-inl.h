@@ -137,6 +137,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
   x.edge = Select(on, k_exit, SplatI(-1));
   x.corner = hn::And(on, lane::near_end(u, tolerance).m);
   x.cosine = cosine;
+  x.index = at.edges;  // known before `on`: where it fails, the lane does not cross
   // Lanes with no edge found have the full loop's answer already (it finds none either).
   const M rest = hn::AndNot(on, hn::And(m, found));
   if (Any(rest)) {
@@ -145,6 +146,7 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
     x.edge = Select(rest, full.edge, x.edge);
     x.corner = hn::Or(hn::AndNot(rest, x.corner), hn::And(rest, full.corner));
     x.cosine = Select(rest, full.cosine, x.cosine);
+    x.index = Select(rest, full.index, x.index);
   }
   return x;
 }

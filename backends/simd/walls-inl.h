@@ -369,6 +369,7 @@ class Walls {
       tolerance_exit = Select(ok, tolerance, tolerance_exit);
     }
     x.corner = lane::near_end(u_exit, tolerance_exit).m;
+    x.index = Select(AtLeastZero(x.edge), rooms.first_edge + x.edge, SplatI(0));
     return x;
   }
 
@@ -414,9 +415,12 @@ class Walls {
   // glued room and are placed `push` inside the edge they are then behind: march.glsl's
   // cross_edge when every edge is glued and the scene's edges fit in a vector (merge()), each
   // lane looking its edge's gluing up (glue_), all in one round. `cosine`: the rays' component
-  // along the edges' normals where known (Exit::cosine), else null. The caller records the event.
+  // along the edges' normals where known (Exit::cosine), else null. kInTable: `edge` is an index
+  // of the table in every lane (Exit::index), so the lookups need not wait for `m`. The caller
+  // records the event.
+  template <bool kInTable>
   FLATMARCH_PACKET_INLINE void cross_glued(Packet& r, M m, VI edge, V push, const V* cosine) const {
-    const VI at = Select(m, edge, SplatI(0));
+    const VI at = kInTable ? edge : Select(m, edge, SplatI(0));
     const auto glue = [&](size_t f) FLATMARCH_PACKET_LAMBDA {
       return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
     };
