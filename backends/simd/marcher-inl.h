@@ -264,7 +264,8 @@ class Marcher : private RayEvents {
 
   // One iteration of the analytic method for the rays of `m`, in `rooms`. kNearest: the exit by
   // the nearest line (step's); kCarry: the step's copy (step<true>), where a crossing reads its
-  // tint's cosine from the exit (Exit::cosine), whatever pass found it.
+  // tint's cosine and its edge's index from the exit (Exit::cosine, Exit::index), whatever pass
+  // found it.
   template <bool kOneRoom, bool kNearest = false, bool kCarry = false>
   FLATMARCH_PACKET_INLINE void analytic_step(Packet& r, Segment& seg, M m,
                                              const Rooms& rooms) const {
@@ -325,9 +326,9 @@ class Marcher : private RayEvents {
     rest = hn::AndNot(wall, rest);
     if (Any(rest)) {
       advance(r, rest, seg.exit.s);
-      // The exit's cosine carried in the nearest line's copy alone (MarchPacketsWith<true>):
-      // carried in the other, its sphere and relaxed tracing, which never read it, were
-      // 1.02-1.04x slower.
+      // The exit (its cosine and index) carried in the nearest line's copy alone
+      // (MarchPacketsWith<true>): the cosine carried in the other too, its sphere and relaxed
+      // tracing, which never read it, were 1.02-1.04x slower.
       cross_edge(r, rest, rooms, seg.exit.edge, Splat(0.0f), kCarry ? &seg.exit : nullptr);
       seg.known = hn::AndNot(rest, seg.known);
     }
