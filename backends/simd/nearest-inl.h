@@ -36,6 +36,19 @@ HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
 namespace HWY_NAMESPACE {
 
+// Each lane's edge of slot `k` (a lane's own number) in its room, for the lanes of `valid` (0
+// elsewhere): every number looked up by lane, none read alike by slot (a slot number past those,
+// kAlikeSlots, so that Walls::field looks every number up).
+FLATMARCH_PACKET_INLINE Walls::Slot SlotByLane(const Rooms& rooms, M valid, VI k) {
+  Walls::Slot at;
+  at.edge = 0;
+  at.k = kAlikeSlots;
+  at.rooms = &rooms;
+  at.valid = valid;
+  at.edges = Select(valid, rooms.first_edge + k, SplatI(0));
+  return at;
+}
+
 // Of a pair of opposite slots k and j (Walls::opposite_pairs), the one a ray of `m` moves
 // towards, if any: its slot, its line's distance s, its dn, and whether the nearest-line loop
 // below would take it as the first edge it tests (`first`: moved towards, s >= least, s < kFar)
@@ -58,12 +71,7 @@ FLATMARCH_PACKET_INLINE PairEdge TowardsOfPair(const Walls& walls, M m, const Ro
                      Select(take_k, nky, walls.field<false>(at_j, kNy)));
   PairEdge e;
   e.slot = Select(take_k, SplatI(k), SplatI(j));
-  Walls::Slot at;  // the lane's edge, looked up by lane (a slot number past those read alike)
-  at.edge = 0;
-  at.k = kAlikeSlots;
-  at.rooms = &rooms;
-  at.valid = m;
-  at.edges = Select(m, rooms.first_edge + e.slot, SplatI(0));
+  const Walls::Slot at = SlotByLane(rooms, m, e.slot);  // the lane's own edge
   e.dn = lane::dot(dh, n).v;
   e.s = lane::line_distance(o, n, walls.field<false>(at, kNa), e.dn).v;
   e.base = hn::AndNot(e.s < least, hn::And(m, e.dn > Splat(0.0f)));
@@ -115,15 +123,9 @@ FLATMARCH_PACKET_INLINE Exit ExitByNearestLine(const Walls& walls, M m, const Ro
     k_exit = Select(ok, SplatI(k), k_exit);
     cosine = Select(ok, dn, cosine);
   }
-  // The edge found, each lane's own: its numbers looked up by lane (a slot number past those
-  // read alike by slot, so that field() looks every number up).
+  // The edge found, each lane's own: its numbers looked up by lane.
   const M found = AtLeastZero(k_exit);
-  Walls::Slot at;
-  at.edge = 0;
-  at.k = kAlikeSlots;
-  at.rooms = &rooms;
-  at.valid = found;
-  at.edges = Select(found, rooms.first_edge + k_exit, SplatI(0));
+  const Walls::Slot at = SlotByLane(rooms, found, k_exit);
   const V u =
       lane::edge_parameter(o + lane::real(s_line) * dh,
                            lane::vec2(walls.field<false>(at, kAx), walls.field<false>(at, kAy)),
