@@ -1,6 +1,8 @@
 // The GPU backends, OpenGL (through EGL or OSMesa) and Vulkan (any device; here lavapipe), side
 // by side: every gallery scene and method at 640x360 and 1920x1080 (BACKEND/METHOD/SCENE/WxH),
-// and the original web app's benchmark views at 640x360 (peer/BACKEND/SCENE/METHOD). Given the
+// a frame's fixed cost at each size (fixed/BACKEND/WxH: the L-shape at max_steps 0, no step
+// marched: the pipeline, the camera rays, the shading and the read-back), and the original web
+// app's benchmark views at 640x360 (peer/BACKEND/SCENE/METHOD). Given the
 // app's shaders (--peer-shaders=DIR, regenerated as ../shared/peer-shaders.md says; or the
 // environment's FLATMARCH_PEER_SHADERS), each view is also drawn by the app's own shader on the
 // same OpenGL device (peer/app/SCENE), and every case of that view reports its speed-up over it
@@ -133,6 +135,20 @@ int main(int argc, char** argv) {
             ->UseRealTime();
       }
   }
+  for (const bench::Size size : bench::kSizes)
+    for (const auto& scene : scenes) {
+      if (scene->name != "l_shape") continue;
+      MarchParams params;
+      params.method = Method::analytic;
+      params.max_steps = 0;  // no step: what every frame costs before its march
+      for (const Backend* backend : available)
+        bench::add(("fixed/" + backend->name() + "/" + std::to_string(size.width) + "x" +
+                    std::to_string(size.height))
+                       .c_str(),
+                   bench::frame, backend, scene.get(), scene->camera, params, size, std::string())
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+    }
   for (const bench::Size size : bench::kSizes)
     for (Method method : kKernelMethods)
       for (const auto& scene : scenes)
