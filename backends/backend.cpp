@@ -80,6 +80,11 @@ Trace shader_trace(const unsigned char* buffer, int max_events) {
 
 namespace {
 
+constexpr const char* kKernelShapeHelp =
+    "auto, software or gpu: the kernel shaped for a software rasteriser (a fragment shader "
+    "whose loops test at their end, rare work out of branches) or for a GPU (a compute shader, "
+    "loops testing first); auto: software on llvmpipe and lavapipe, gpu on a GPU";
+
 std::vector<BackendEntry>& registry() {
   static std::vector<BackendEntry> entries{
       {.name = "oracle",
@@ -108,7 +113,8 @@ std::vector<BackendEntry>& registry() {
        .options = {{"--device", &BackendOptions::device,
                     "the device, by its index or a part of its name as `flatmarch backends` "
                     "lists them (default: a GPU, else the CPU: llvmpipe through EGL, then "
-                    "OSMesa)"}}},
+                    "OSMesa)"},
+                   {"--kernel-shape", &BackendOptions::kernel_shape, kKernelShapeHelp}}},
       {.name = "vulkan",
        .make = [](const BackendOptions& o) { return std::make_unique<VulkanBackend>(o); },
        .options = {{"--device", &BackendOptions::device,
@@ -116,12 +122,15 @@ std::vector<BackendEntry>& registry() {
                     "(default: a discrete, integrated or virtual GPU, else lavapipe)"},
                    {"--vk-staging", &BackendOptions::vk_staging,
                     "read frames back through a staging buffer, as on a discrete GPU, even where "
-                    "the device's memory is host-visible"}}},
+                    "the device's memory is host-visible"},
+                   {"--kernel-shape", &BackendOptions::kernel_shape, "likewise"}}},
       {.name = "webgl",
        .make = [](const BackendOptions& o) { return std::make_unique<WebGlBackend>(o); },
        .options = {{"--device", &BackendOptions::device,
                     "gpu or swiftshader (default: Chromium's choice, a GPU where it can "
-                    "use one, else SwiftShader)"}}},
+                    "use one, else SwiftShader)"},
+                   {"--kernel-shape", &BackendOptions::kernel_shape,
+                    "likewise, the page's shader (auto: by the browser's renderer)"}}},
   };
   return entries;
 }

@@ -2,6 +2,7 @@
 // parameters of DESIGN.md section 3 and the outputs of section 4.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <new>
@@ -94,13 +95,26 @@ struct UninitialisedAllocator : std::allocator<T> {
 // threads that render it, in parallel, rather than zeroed beforehand by one.
 using Channel = std::vector<float, UninitialisedAllocator<float>>;
 
-// A rendered frame: colour and the AOVs, row-major with row 0 at the top.
+// A rendered frame: colour and the AOVs, row-major with row 0 at the top. A frame of its colour
+// alone (Backend::render_colour, from a GPU backend) has `srgb` instead, and no other channel.
 struct Frame {
   int width = 0, height = 0;
   Channel rgb;  // linear colour, 3 floats a pixel
   Channel steps, crossings, hit, t;
+  // The colour as a PNG holds it: tone-mapped, sRGB-encoded, 8 bits a channel, 4 bytes a pixel
+  // (r, g, b, 255); empty but in a frame of the colour alone.
+  std::vector<uint8_t, UninitialisedAllocator<uint8_t>> srgb;
 
   Frame() = default;
+  // A frame of the colour alone: only `srgb`, to be written in full.
+  static Frame colour_only(int w, int h) {
+    Frame f;
+    f.width = w;
+    f.height = h;
+    f.srgb.resize(4 * static_cast<size_t>(w) * static_cast<size_t>(h));
+    return f;
+  }
+  bool has_aovs() const { return !hit.empty(); }
   // Every pixel must then be written (set). Inline: the image module (output/image_library.hpp)
   // makes frames without linking the backends.
   Frame(int w, int h)
@@ -156,6 +170,20 @@ struct DeviceInfo {
   std::string driver;     // "Mesa 22.3.6", "NVIDIA 550.54.15", "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)"
   std::string platform;   // how the backend reached it: "EGL device", "OSMesa", "Vulkan"
   bool software = false;  // a rasteriser running on the CPU (llvmpipe, lavapipe, SwiftShader)
+  // The kernel's shape the backend runs on it (BackendOptions::kernel_shape, resolved):
+  // "software" or "gpu".
+  std::string kernel_shape;
+};
+
+// A frame's time on its device, by the device's own clock (OpenGL timer queries, Vulkan timestamp
+// queries), where a GPU backend could measure it: what the hardware did, apart from the
+// submission, the waits and the host's work, which the clock around render() counts too.
+struct DeviceTiming {
+  bool measured = false;
+  std::string why;          // why not, when not measured (the device has no timer, ...)
+  double march_s = 0.0;     // the draws or dispatches that march the frame's rays
+  double readback_s = 0.0;  // the copies that bring it where the host reads it
+  double seconds() const { return march_s + readback_s; }
 };
 
 struct Availability {
@@ -171,6 +199,9 @@ struct BackendOptions {
   // backends`); empty: a GPU if there is one (vulkan: discrete, integrated, virtual), else the CPU
   // (llvmpipe through EGL, then OSMesa; lavapipe).
   std::string device{};
+  // opengl, vulkan, webgl: the kernel's shape (KernelShape): "auto" (or empty), "software" or
+  // "gpu".
+  std::string kernel_shape{};
   // vulkan: read frames back through a staging buffer even where the device's memory is
   // host-visible, as on a discrete GPU (so that the path is tested on any device).
   bool vk_staging = false;
@@ -197,6 +228,16 @@ class Backend {
 
   virtual Frame render(const Scene& scene, const Camera& camera, int width, int height,
                        const MarchParams& params, const Progress& progress) const = 0;
+  // A frame for the eye or the clock: at least its colour. The GPU backends read back the 8-bit
+  // sRGB colour alone (Frame::srgb, a ninth of render()'s read-back); the others give render()'s
+  // frame. Timed runs draw these; whatever compares frames draws render()'s.
+  virtual Frame render_colour(const Scene& scene, const Camera& camera, int width, int height,
+                              const MarchParams& params, const Progress& progress) const {
+    return render(scene, camera, width, height, params, progress);
+  }
+  // The last render() or render_colour() on the device's own clock (GPU backends; measured, or
+  // why not). Nothing from a backend that runs on no device of its own (the CPU backends).
+  virtual std::optional<DeviceTiming> last_device_timing() const { return std::nullopt; }
   // The time the last render() took as the backend measured it itself, where a clock around
   // render() would count more than the frame (webgl: the browser's round trip); unset where the
   // clock around render() is the measure. The benchmarks time frames by it when set.

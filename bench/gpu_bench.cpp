@@ -45,15 +45,23 @@ double median(std::vector<double> v) {
 
 void frame(benchmark::State& state, const Backend* backend, const Scene* scene, Camera camera,
            MarchParams params, Size size, std::string view) {
-  if (const std::optional<DeviceInfo> d = backend->device())
-    state.SetLabel(reports::device_label(*d));
-  // The first frame compiles the scene's program; it is not timed.
-  Frame f = backend->render(*scene, camera, size.width, size.height, params, {});
+  std::string label;
+  if (const std::optional<DeviceInfo> d = backend->device()) label = reports::device_label(*d);
+  // The first frame compiles the scene's program; it is not timed, and the counters are its.
+  // The timed ones are frames of the colour alone, as a user waits for them.
+  const Frame whole = backend->render(*scene, camera, size.width, size.height, params, {});
+  reports::DeviceTimes device;
   for (auto _ : state) {
-    f = backend->render(*scene, camera, size.width, size.height, params, {});
-    benchmark::DoNotOptimize(f.rgb.data());
+    const auto start = std::chrono::steady_clock::now();
+    const Frame f = backend->render_colour(*scene, camera, size.width, size.height, params, {});
+    benchmark::DoNotOptimize(f.srgb.data());
+    device.add(*backend,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
-  bench::frame_counters(state, f);
+  if (!device.why().empty()) label += "; no device clock: " + device.why();
+  state.SetLabel(label);
+  bench::frame_counters(state, whole);
+  device.counters(state);
   if (!view.empty() && !app_ms[view].empty()) {
     const double app = median(app_ms[view]);
     state.counters["app_ms"] = app;

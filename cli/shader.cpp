@@ -16,13 +16,15 @@ namespace flatmarch::cli {
 void add_shader(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "shader",
-      "Print the GLSL shader a GPU backend runs for a scene: the opengl backend's fragment shader\n"
-      "or the vulkan backend's compute shader (--backend vulkan), the kernel specialised on the\n"
-      "features the scene uses, with its tables baked in as constants. The march parameters are\n"
-      "baked in too (a change of method or eps is a new program). --compile compiles it (or a\n"
-      "file of yours with --file) and shows any error with the lines around it.");
+      "Print the GLSL shader a GPU backend runs for a scene's whole frames: the opengl backend's\n"
+      "fragment shader (--kernel-shape software) or compute shader (gpu), or the vulkan backend's\n"
+      "compute shader (--backend vulkan), the kernel specialised on the features the scene uses,\n"
+      "with its tables baked in as constants. The march parameters are baked in too (a change of\n"
+      "method or eps is a new program). --compile compiles it (or a file of yours with --file) "
+      "and\n"
+      "shows any error with the lines around it.");
   struct Options {
-    std::string scene, file, out, backend = "opengl";
+    std::string scene, file, out, backend = "opengl", shape = "software";
     bool trace = false, compile = false;
   };
   auto o = std::make_shared<Options>();
@@ -35,8 +37,13 @@ void add_shader(CLI::App& app) {
   cmd->add_flag("--compile", o->compile,
                 "Compile it with that backend (OSMesa's driver; glslang and the Vulkan device) and "
                 "report errors");
+  cmd->add_option("--kernel-shape", o->shape,
+                  "software or gpu: the kernel shaped for a software rasteriser or a GPU (the "
+                  "backends' --kernel-shape; auto picks by the device)")
+      ->capture_default_str();
   cmd->add_option("--file", o->file,
-                  "With --compile: compile this fragment shader instead of the generated one")
+                  "With --compile: compile this shader (of the same stage) instead of the "
+                  "generated one")
       ->check(CLI::ExistingFile);
   cmd->callback([o] {
     const Scene scene = load_scene(o->scene);
@@ -45,9 +52,18 @@ void add_shader(CLI::App& app) {
     if (o->backend != "opengl" && o->backend != "vulkan")
       throw UsageError("--backend: expected opengl or vulkan, got \"" + o->backend + "\"");
     const bool vulkan = o->backend == "vulkan";
+    if (o->shape != "software" && o->shape != "gpu")
+      throw UsageError("--kernel-shape: expected software or gpu, got \"" + o->shape + "\"");
+    const KernelShape shape = o->shape == "gpu" ? KernelShape::gpu : KernelShape::software;
+    // The OpenGL backend's gpu shape is a compute shader too, but for its probe-ray traces.
+    const bool compute = vulkan || (shape == KernelShape::gpu && !o->trace);
     const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
-    std::string source = vulkan ? kernel::scene_compute_shader(tables, o->trace)
-                                : kernel::scene_fragment_shader(tables, o->trace);
+    const kernel::ShaderVariant variant{
+        .trace = o->trace, .shape = shape, .readback = kernel::Readback::all};
+    std::string source = compute ? kernel::scene_compute_shader(tables, variant,
+                                                                vulkan ? kernel::ComputeApi::vulkan
+                                                                       : kernel::ComputeApi::opengl)
+                                 : kernel::scene_fragment_shader(tables, variant);
     if (!o->file.empty()) {
       if (!o->compile) throw UsageError("--file: goes with --compile");
       std::ifstream in(o->file, std::ios::binary);
@@ -65,7 +81,7 @@ void add_shader(CLI::App& app) {
         if (vulkan)
           vulkan_backend.compile(source);
         else
-          opengl.compile(source);
+          opengl.compile(source, compute);
       } catch (const kernel::ShaderError& e) {
         throw UsageError(std::string(o->file.empty() ? "the generated shader" : o->file) + ": " +
                          e.what());

@@ -32,11 +32,12 @@ int room(int polygon) {
   return params.polygon_count == 1 ? 0 : polygon;
 }
 
-// Edge k of a polygon's room. In a baked shader of a one-polygon scene the edge is picked from
-// constants rather than read at a per-ray index (a gather, the slowest read a SIMD shader core
-// makes); the record is the same.
+// Edge k of a polygon's room. In a baked shader of a one-polygon scene the software shape picks
+// the edge from constants rather than read it at a per-ray index (a gather, the slowest read a
+// SIMD shader core makes); the record is the same. (FLATMARCH_GPU_SHAPE, a shader's gpu shape:
+// a GPU reads a table at a per-ray index from its caches, and the picking would read them all.)
 EdgeRecord edge_at(int polygon, int k) {
-#ifdef FLATMARCH_SHADER
+#if defined(FLATMARCH_SHADER) && !defined(FLATMARCH_GPU_SHAPE)
   if (params.polygon_count == 1) {
     EdgeRecord e = edges[0];
     for (int j = 1; j < polygons[0].y; ++j) {
@@ -313,10 +314,10 @@ void hit_solid(INOUT(Ray) r, int k) {
 }
 
 void solid_look(INOUT(Ray) r) {
-#ifdef FLATMARCH_FEW_OBJECTS
+#if defined(FLATMARCH_FEW_OBJECTS) && !defined(FLATMARCH_GPU_SHAPE)
   // A few objects baked in: each solid's normal is evaluated with the solid's shape known (its
   // number a constant), and the one hit kept, rather than every shape's distance at a per-ray
-  // index.
+  // index (the software shape: a GPU evaluates only the shapes its lanes hit).
   vec3 normal = vec3(real(0));
   vec4 color = vec4(real(0));
   for (int k = 0; k < objects.length(); ++k) {
@@ -526,9 +527,22 @@ Ray march(int polygon, vec3 from, vec3 dir) {
   seg.exit.edge = -1;
   seg.exit.corner = false;
   seg.solids = real(kFar);
-  // The loops test at their end (do-while), and every step is one iteration: a shader core runs
-  // a loop's body, masked, until no lane is left in it, and a test at the top costs a whole
-  // masked pass more.
+#ifdef FLATMARCH_GPU_SHAPE
+  // A GPU's shader core leaves a loop once none of its lanes is left in it, and skips a branch
+  // that none of them takes: one loop, testing first, the solids only in the steps near them
+  // (analytic_step). The same steps in the same order as the software shape's loops below.
+  while (!r.done && r.steps < params.max_steps) {
+    r.steps += 1;
+    if (params.method == kMethodAnalytic) {
+      analytic_step(r, seg);
+    } else {
+      sphere_step(r, x);
+    }
+  }
+#else
+  // The software shape's loops test at their end (do-while), and every step is one iteration: a
+  // software rasteriser's shader core runs a loop's body, masked, until no lane is left in it,
+  // and a test at the top costs a whole masked pass more.
   if (params.max_steps > 0 && !r.done) {
     if (params.method == kMethodAnalytic && has(kFeatureObjects)) {
       // The analytic method's steps, in two loops: the steps that take a whole room segment, as
@@ -563,6 +577,7 @@ Ray march(int polygon, vec3 from, vec3 dir) {
       } while (!r.done && r.steps < params.max_steps);
     }
   }
+#endif
   if (!r.done) finish(r, kHitMaxSteps, kEventMaxSteps, -1, real(0));
   if (has(kFeatureObjects) && r.object >= 0) solid_look(r);
   return r;

@@ -31,4 +31,16 @@ std::string method_names() {
   return names;
 }
 
+const char* to_string(KernelShape s) {
+  return s == KernelShape::software ? "software" : "gpu";
+}
+
+std::optional<KernelShape> parse_kernel_shape(const std::string& text, bool software_device) {
+  if (text.empty() || text == "auto")
+    return software_device ? KernelShape::software : KernelShape::gpu;
+  if (text == "software") return KernelShape::software;
+  if (text == "gpu") return KernelShape::gpu;
+  return std::nullopt;
+}
+
 }  // namespace flatmarch

@@ -23,6 +23,19 @@ std::optional<Method> parse_method(const std::string& name);
 // Every method's name, in order, joined by ", " (for help texts and errors).
 std::string method_names();
 
+// How a GPU backend shapes the kernel and its launch (--kernel-shape). A software rasteriser
+// (llvmpipe, lavapipe) runs every branch's code for every lane, taken or not, and a loop's body
+// at least once, so the `software` shape keeps rare work out of branches, tests loops at their
+// end, reads a one-room scene's edges at constant indices and draws a fragment shader; the `gpu`
+// shape is the plain kernel, its loops testing first, run as a compute shader on every backend
+// (a datacenter GPU runs fragment shaders on a few of its units only: docs/gpu.md). Both
+// give the same steps, crossings and hits to the bit (device_paths_test).
+enum class KernelShape { software, gpu };
+const char* to_string(KernelShape s);
+// "auto" (or empty): the software shape on a software device, else the gpu shape; "software",
+// "gpu": that shape. Nothing for any other text.
+std::optional<KernelShape> parse_kernel_shape(const std::string& text, bool software_device);
+
 struct MarchParams {
   Method method = Method::sphere;
   double eps = 1e-4;

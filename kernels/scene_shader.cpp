@@ -47,6 +47,15 @@ std::string array(bool constant, const char* type, const char* name,
   return s;
 }
 
+// The sRGB transfer function (IEC 61966-2-1), as OpenImageIO encodes the PNGs of `render`: for
+// the web page's canvas and the frames of the colour alone (Readback::colour).
+const char* const kSrgb = R"glsl(
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+)glsl";
+
 const char* const kFragmentMain = R"glsl(
 uniform int u_polygon;
 uniform vec3 u_from;
@@ -57,20 +66,18 @@ uniform vec2 u_scale;
 uniform vec2 u_size;
 uniform vec2 u_rows;  // the pixel's row from the top is u_rows.x + u_rows.y * gl_FragCoord.y
 
+#ifdef FLATMARCH_COLOUR8
+layout(location = 0) out uint out_srgb;  // packUnorm4x8 of the sRGB colour
+#else
 layout(location = 0) out vec4 out_color;
-#ifndef FLATMARCH_CANVAS
+#endif
+#if defined(FLATMARCH_PACKED_AOVS)
+layout(location = 1) out uvec4 out_aov;  // steps, crossings, hit (two's complement), t's bits
+#elif !defined(FLATMARCH_CANVAS) && !defined(FLATMARCH_COLOUR8)
 layout(location = 1) out vec4 out_aov;
 #endif
 #ifdef FLATMARCH_TRACE_PICK
 layout(location = 2) out vec4 out_at;
-#endif
-
-#ifdef FLATMARCH_CANVAS
-// The sRGB transfer function (IEC 61966-2-1), as OpenImageIO encodes the PNGs of `render`.
-vec3 srgb(vec3 c) {
-  c = clamp(c, 0.0, 1.0);
-  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
 #endif
 
 void main() {
@@ -95,8 +102,13 @@ void main() {
   float u = (2.0 * p.x / u_size.x - 1.0) * u_scale.x;
   float v = (1.0 - 2.0 * p.y / u_size.y) * u_scale.y;
   Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));
-#ifdef FLATMARCH_CANVAS
+#if defined(FLATMARCH_CANVAS)
   out_color = vec4(srgb(shade(r)), 1.0);
+#elif defined(FLATMARCH_COLOUR8)
+  out_srgb = packUnorm4x8(vec4(srgb(shade(r)), 1.0));
+#elif defined(FLATMARCH_PACKED_AOVS)
+  out_color = vec4(shade(r), 1.0);
+  out_aov = uvec4(uint(r.steps), uint(r.crossings), uint(r.hit), floatBitsToUint(r.t));
 #else
   out_color = vec4(shade(r), 1.0);
   out_aov = vec4(float(r.steps), float(r.crossings), float(r.hit), r.t);
@@ -105,10 +117,14 @@ void main() {
 }
 )glsl";
 
-// The Vulkan backend's main() (see scene_compute_shader). The pixel's ray is computed as the
+// The compute shaders' main() (see scene_compute_shader). The pixel's ray is computed as the
 // fragment shader computes it.
 const char* const kComputeMain = R"glsl(
+#ifdef FLATMARCH_GL_COMPUTE
+layout(std140, binding = 0) uniform Constants {
+#else
 layout(push_constant) uniform Constants {
+#endif
   vec4 from;
   vec4 forward;
   vec4 right;
@@ -126,7 +142,11 @@ void main() {
 }
 #else
 layout(local_size_x = TILE, local_size_y = TILE) in;
-layout(std430, binding = 5) writeonly buffer Pixels { vec4 pixels[]; };
+#ifdef FLATMARCH_COLOUR8
+layout(std430, binding = 5) writeonly buffer Pixels { uint pixels[]; };
+#else
+layout(std430, binding = 5) writeonly buffer Pixels { uvec4 pixels[]; };
+#endif
 void main() {
   // The workgroups' rows draw the band's rows of tiles in a spread order (row_stride).
   uint row = (gl_WorkGroupID.y * uint(pc.order.x)) % gl_NumWorkGroups.y;
@@ -139,10 +159,14 @@ void main() {
     Ray r = march(pc.frame.w, pc.from.xyz,
                   normalize(pc.forward.xyz + u * pc.right.xyz + v * pc.up.xyz));
     vec3 color = shade(r);
-    uint n = uint(pc.frame.x) * uint(pc.frame.y);
     uint px = uint(p.y) * uint(pc.frame.x) + uint(p.x);
-    pixels[px] = vec4(color, 1.0);
-    pixels[n + px] = vec4(float(r.steps), float(r.crossings), float(r.hit), r.t);
+#ifdef FLATMARCH_COLOUR8
+    pixels[px] = packUnorm4x8(vec4(srgb(color), 1.0));
+#else
+    uint n = uint(pc.frame.x) * uint(pc.frame.y);
+    pixels[px] = floatBitsToUint(vec4(color, 1.0));
+    pixels[n + px] = uvec4(uint(r.steps), uint(r.crossings), uint(r.hit), floatBitsToUint(r.t));
+#endif
   }
 }
 #endif
@@ -196,7 +220,17 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays)
 }
 
 namespace {
-const char* const kFromBand = "#define FLATMARCH_FROM_BAND\n";
+
+// The defines that pick a variant's code, after the baked tables.
+std::string variant_defines(const ShaderVariant& v) {
+  std::string s;
+  if (v.from_band && !v.trace) s += "#define FLATMARCH_FROM_BAND\n";
+  if (v.shape == KernelShape::gpu) s += "#define FLATMARCH_GPU_SHAPE\n";
+  if (!v.trace && v.readback == Readback::colour) s += "#define FLATMARCH_COLOUR8\n";
+  if (!v.trace && v.readback == Readback::all) s += "#define FLATMARCH_PACKED_AOVS\n";
+  return s;
+}
+
 }  // namespace
 
 bool within_band(const SceneTables<float>& tables, const glm::dvec3& position) {
@@ -204,15 +238,19 @@ bool within_band(const SceneTables<float>& tables, const glm::dvec3& position) {
   return !(z < 0.0f || z > tables.params.height);
 }
 
-std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace, bool from_band) {
-  const std::string baked = baked_tables(tables) + (from_band && !trace ? kFromBand : "");
-  return shader_source(tables.features, baked, trace) + kFragmentMain;
+std::string scene_fragment_shader(const SceneTables<float>& tables, const ShaderVariant& v) {
+  return shader_source(tables.features, baked_tables(tables) + variant_defines(v), v.trace) +
+         kSrgb + kFragmentMain;
 }
 
-std::string scene_compute_shader(const SceneTables<float>& tables, bool trace, bool from_band) {
-  const std::string baked = baked_tables(tables, false) + (from_band && !trace ? kFromBand : "");
-  return shader_source(tables.features, baked, trace) + "\n#define TILE " +
-         std::to_string(kComputeTile) + "\n" + kComputeMain;
+std::string scene_compute_shader(const SceneTables<float>& tables, const ShaderVariant& v,
+                                 ComputeApi api) {
+  ShaderVariant compute = v;
+  if (compute.readback == Readback::floats) compute.readback = Readback::all;
+  return shader_source(tables.features, baked_tables(tables, false) + variant_defines(compute),
+                       v.trace) +
+         (api == ComputeApi::opengl ? "#define FLATMARCH_GL_COMPUTE\n" : "") + "#define TILE " +
+         std::to_string(kComputeTile) + "\n" + kSrgb + kComputeMain;
 }
 
 namespace {
@@ -231,8 +269,9 @@ std::string web_fragment_shader(const SceneTables<float>& tables, WebShader kind
                                  "#define FLATMARCH_TRACE_PICK\n"};
   // Plain global arrays, not constants: SwiftShader (Chromium's WebGL without a GPU) crashes its
   // GPU process on a struct read from a constant array at an index known only at run time.
-  return as_glsl_es(shader_source(tables.features, baked_tables(tables, false)) + kFragmentMain,
-                    defines[static_cast<int>(kind)]);
+  return as_glsl_es(
+      shader_source(tables.features, baked_tables(tables, false)) + kSrgb + kFragmentMain,
+      defines[static_cast<int>(kind)]);
 }
 
 const char* const kWebVertexShader = R"glsl(#version 300 es

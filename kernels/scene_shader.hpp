@@ -19,20 +19,44 @@ namespace flatmarch::kernel {
 // `constant_arrays`: declare the tables `const` (false: plain globals with the same initialisers).
 std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays = true);
 
+// What a frame's shader writes, and its backend reads back.
+enum class Readback {
+  // The colour alone, tone-mapped and sRGB-encoded (as OpenImageIO writes the PNGs): one uint a
+  // pixel, packUnorm4x8's, r in the low byte. What a timed frame or a display needs.
+  colour,
+  // The linear colour's float bits, then the AOVs as integers (steps, crossings, hit as two's
+  // complement) and t's float bits: two uvec4 a pixel. What a comparison needs.
+  all,
+  // The fragment shader for the viewer and the web page's read-back: the linear colour and the
+  // AOVs (steps, crossings, hit, t) as floats, in two float targets (a float target can be
+  // filtered and mipmapped: the viewer's mean steps). The compute shader makes `all` of it.
+  floats,
+};
+
+// Which of a scene's shaders.
+struct ShaderVariant {
+  // The variant that marches one probe ray (u_polygon, u_from and the direction u_forward) and
+  // writes its events to the event buffer (binding 4, see kernels/shader_prelude.glsl).
+  bool trace = false;
+  // Every ray starts within the band [0, height] (a camera there, not a probe ray): the shader
+  // then leaves out how a ray from outside enters the band. llvmpipe and lavapipe run the code of
+  // every branch for every pixel, taken or not and uniform or not, and the entry tests the ray
+  // against every polygon's footprint (0.4 of the L-shape's 13 ms a 640x360 frame).
+  bool from_band = false;
+  KernelShape shape = KernelShape::software;  // kernels/march.glsl's FLATMARCH_GPU_SHAPE
+  Readback readback = Readback::floats;       // a frame's outputs (not a trace's)
+};
+
 // Uniforms of the fragment shader (scene_fragment_shader):
 //   u_polygon, u_from         the camera's polygon and position
 //   u_forward, u_right, u_up  its basis (kernels/camera.hpp)
 //   u_scale                   (aspect * tan(fov / 2), tan(fov / 2))
 //   u_size                    the image's width and height in pixels
-// Outputs: location 0 the linear colour (rgb, 1), location 1 the AOVs (steps, crossings, hit, t).
-// With `trace` it marches one probe ray instead (u_polygon, u_from and the direction u_forward)
-// and writes its events to the event buffer (binding 4, see kernels/shader_prelude.glsl).
-// `from_band`: every ray starts within the band [0, height] (a camera there, not a probe ray):
-// the shader then leaves out how a ray from outside enters the band. llvmpipe and lavapipe run
-// the code of every branch for every pixel, taken or not and uniform or not, and the entry tests
-// the ray against every polygon's footprint (0.4 of the L-shape's 13 ms a 640x360 frame).
-std::string scene_fragment_shader(const SceneTables<float>& tables, bool trace = false,
-                                  bool from_band = false);
+// Outputs by the variant's readback: colour, location 0 the uint (packUnorm4x8); all, location
+// 0 the linear colour (rgb, 1) and 1 the uvec4 of AOVs; floats, 0 the colour and 1 the AOVs as
+// a vec4. The trace variant marches one probe ray instead.
+std::string scene_fragment_shader(const SceneTables<float>& tables,
+                                  const ShaderVariant& variant = {});
 
 // The web page's fragment shaders (web/page.hpp): scene_fragment_shader's kernel, baked tables,
 // uniforms and main() in GLSL ES 3.00 for WebGL2. Every ray may start outside the band.
@@ -53,21 +77,25 @@ extern const char* const kWebVertexShader;
 // Whether a camera at `position` sees from within the band, as the kernel tests it.
 bool within_band(const SceneTables<float>& tables, const glm::dvec3& position);
 
-// The compute shader of the Vulkan backend: the same kernel and tables, one invocation a pixel in
-// workgroups of kComputeTile x kComputeTile, over rows frame.z .. of the image (a band). Push
-// constants (ComputeConstants): the camera's position, basis and scale as above, and frame =
-// (width, height, first row, polygon). Output: buffer binding 5, `vec4 pixels[]`, rows from the
-// top: the colour (rgb, 1) of every pixel, then the AOVs (steps, crossings, hit, t) of every
-// pixel (two 16-byte stores a pixel ran up to 1.2x faster on lavapipe than seven planar float
-// stores). The trace variant (one invocation) marches the ray from `from` along
-// `forward` in polygon frame.w and writes its events to binding 4 as the fragment shader's does.
+// The compute shader of the Vulkan backend, and of the OpenGL backend's gpu shape: the same
+// kernel and tables, one invocation a pixel in workgroups of kComputeTile x kComputeTile, over
+// rows frame.z .. of the image (a band). Constants (ComputeConstants: Vulkan's push constants,
+// OpenGL's uniform block at binding 0): the camera's position, basis and scale as above, and
+// frame = (width, height, first row, polygon). Output: buffer binding 5, rows from the top; by
+// the variant's readback, `uint pixels[]` of the colour (colour), or `uvec4 pixels[]`, the
+// colour's bits of every pixel, then the AOVs of every pixel (all; floats is taken as all; two
+// 16-byte stores a pixel ran up to 1.2x faster on lavapipe than seven planar float stores). The
+// trace variant (one invocation) marches the ray from `from` along `forward` in polygon frame.w
+// and writes its events to binding 4 as the fragment shader's does.
 // Its tables are not `const` arrays but plain ones with the same initialisers: glslang gives a
 // dynamically indexed `const` array a function-local copy at each use (344 in the cube), which
 // lavapipe took 35 s to compile (the plain arrays: 2.4 s, and 0.3 s once SPIRV-Tools' optimiser
 // has run, which in turn made the `const` arrays' copies run 300x slower). Tables in buffers ran
 // 1.4-15x slower: their loads are not folded where the indices are constant.
-std::string scene_compute_shader(const SceneTables<float>& tables, bool trace = false,
-                                 bool from_band = false);
+enum class ComputeApi { vulkan, opengl };
+std::string scene_compute_shader(const SceneTables<float>& tables,
+                                 const ShaderVariant& variant = {},
+                                 ComputeApi api = ComputeApi::vulkan);
 
 // The compute shader's push constants (std430: as laid out in C++).
 struct ComputeConstants {

@@ -32,22 +32,25 @@ json accuracy_summary(const conformance::CaseResult& r) {
   for (const conformance::Check& c : r.checks)
     if (!c.passed) failed.push_back(c.name);
   const double pixels = static_cast<double>(std::max<size_t>(r.aov.pixels, 1));
-  return {{"passed", r.passed},
-          {"verdict", conformance::to_string(r.verdict)},
-          {"limit", r.limit},
-          {"hit_mismatch", 1.0 - r.aov.hit_rate()},
-          {"crossings_mismatch", 1.0 - r.aov.crossings_rate()},
-          {"ambiguous", static_cast<double>(r.aov.ambiguous) / pixels},
-          {"image_fail", static_cast<double>(r.image.fail) /
-                             static_cast<double>(std::max<size_t>(r.image.pixels, 1))},
-          {"image_mean_error", r.image.mean_error},
-          {"traces", r.traces.size()},
-          {"traces_diverged", diverged},
-          {"failures", failures},
-          {"failures_total", total},
-          {"steps_ks", r.steps_ks},
-          {"failed_checks", r.failed_checks()},
-          {"failed", failed}};
+  json summary = {{"passed", r.passed},
+                  {"verdict", conformance::to_string(r.verdict)},
+                  {"limit", r.limit},
+                  {"hit_mismatch", 1.0 - r.aov.hit_rate()},
+                  {"crossings_mismatch", 1.0 - r.aov.crossings_rate()},
+                  {"ambiguous", static_cast<double>(r.aov.ambiguous) / pixels},
+                  {"image_fail", static_cast<double>(r.image.fail) /
+                                     static_cast<double>(std::max<size_t>(r.image.pixels, 1))},
+                  {"image_mean_error", r.image.mean_error},
+                  {"traces", r.traces.size()},
+                  {"traces_diverged", diverged},
+                  {"failures", failures},
+                  {"failures_total", total},
+                  {"steps_ks", r.steps_ks},
+                  {"failed_checks", r.failed_checks()},
+                  {"failed", failed}};
+  // Only where a check was left out: a run with every check has the same summary as before.
+  if (!r.unmeasured.empty()) summary["unmeasured"] = conformance::unmeasured_json(r);
+  return summary;
 }
 
 json device_json(const DeviceInfo& d) {
@@ -57,7 +60,30 @@ json device_json(const DeviceInfo& d) {
 
 std::string device_label(const DeviceInfo& d) {
   return "device " + d.name + "; driver " + d.driver + "; " + d.platform +
-         (d.software ? "; software" : "");
+         (d.software ? "; software" : "") +
+         (d.kernel_shape.empty() ? "" : "; " + d.kernel_shape + " shape");
+}
+
+void DeviceTimes::add(const Backend& backend, double wall_seconds) {
+  const std::optional<DeviceTiming> t = backend.last_device_timing();
+  if (!t) return;
+  if (!t->measured) {
+    why_ = t->why;
+    return;
+  }
+  ++frames_;
+  march_ += t->march_s;
+  readback_ += t->readback_s;
+  wall_ += wall_seconds;
+}
+
+void DeviceTimes::counters(benchmark::State& state) const {
+  if (frames_ == 0) return;
+  const double ms = 1e3 / frames_;
+  state.counters["device_ms"] = (march_ + readback_) * ms;
+  state.counters["march_ms"] = march_ * ms;
+  state.counters["readback_ms"] = readback_ * ms;
+  state.counters["rest_ms"] = std::max(0.0, wall_ - march_ - readback_) * ms;
 }
 
 std::string case_name(const std::string& backend, Method method, const std::string& scene,
@@ -96,7 +122,8 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
   const auto* simd = dynamic_cast<const SimdBackend*>(&backend);
   const std::optional<DeviceInfo> device = backend.device();
   const std::string label = device ? device_label(*device) : "";
-  auto warmed = std::make_shared<bool>(false);
+  // The case's whole frame, drawn once before the first repetition's timed frames.
+  auto whole = std::make_shared<std::optional<Frame>>();
   // The SIMD backend's lane counts and peak, the same in every repetition of a case (its frames
   // are deterministic): measured in the first, the peak over five times --min-time, within 0.01
   // to 0.1 s (the report's default 0.02 s: 0.1 s; the regression gate's 0.01 s: 0.05 s, about
@@ -115,23 +142,24 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
           (name.empty() ? case_name(backend.name(), params.method, scene.name, width, height)
                         : name)
               .c_str(),
-          [&backend, &scene, camera, params, width, height, last, simd, warmed, simd_figures,
+          [&backend, &scene, camera, params, width, height, last, simd, whole, simd_figures,
            peak_seconds, label](benchmark::State& state) {
-            if (!label.empty()) state.SetLabel(label);
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
-            Frame f;
+            DeviceTimes device;
             try {
-              if (!*warmed) f = backend.render(scene, camera, width, height, params, {});
-              *warmed = true;
+              if (!*whole) *whole = backend.render(scene, camera, width, height, params, {});
               for (auto _ : state) {
                 const auto start = std::chrono::steady_clock::now();
-                f = backend.render(scene, camera, width, height, params, {});
+                const Frame f = backend.render_colour(scene, camera, width, height, params, {});
+                benchmark::DoNotOptimize(f.srgb.data());
                 benchmark::DoNotOptimize(f.rgb.data());
                 // The backend's own time where it has one (webgl: the page's, without the
-                // browser's round trip), else the clock's around render().
-                state.SetIterationTime(backend.last_frame_seconds().value_or(
+                // browser's round trip), else the clock's around render_colour().
+                const double seconds = backend.last_frame_seconds().value_or(
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                        .count()));
+                        .count());
+                state.SetIterationTime(seconds);
+                device.add(backend, seconds);
               }
               if (simd && !simd_figures->known) {
                 simd->render_counted(scene, camera, width, height, params, {}, simd_figures->lanes);
@@ -139,13 +167,17 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                     simd->peak_lane_steps(scene, camera, width, height, params, peak_seconds);
                 simd_figures->known = true;
               }
-              if (simd) simd_counters(state, f, simd_figures->lanes, simd_figures->peak);
+              if (simd) simd_counters(state, **whole, simd_figures->lanes, simd_figures->peak);
             } catch (const std::exception& e) {
               state.SkipWithError(e.what());
               return;
             }
-            frame_counters(state, f);
-            if (last) *last = std::move(f);
+            const std::string clock =
+                device.why().empty() ? "" : "no device clock: " + device.why();
+            state.SetLabel(label.empty() || clock.empty() ? label + clock : label + "; " + clock);
+            frame_counters(state, **whole);
+            device.counters(state);
+            if (last) *last = **whole;
           })
           ->Unit(benchmark::kMillisecond)
           ->UseManualTime();

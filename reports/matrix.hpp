@@ -72,16 +72,37 @@ nlohmann::json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions&
 nlohmann::json run_registered_benchmarks(const std::function<void(const std::string&)>& on_run);
 
 // Registers one timed case, BACKEND/METHOD/SCENE/WxH: frames of the scene's camera, after one
-// untimed frame (GPU backends compile the scene's program then), each frame timed by the
-// backend's own measure where it has one (Backend::last_frame_seconds: webgl's page), else by the
-// clock around render() (Google Benchmark's manual time); counters rays_per_s,
-// steps_mean, steps_p99, crossings_mean, out_of_steps and, for the SIMD backend, lane_utilisation,
-// steps_per_s, peak_steps_per_s and of_peak (simd_counters); a GPU backend's runs are labelled with
-// its device (device_label). `last`, when given, receives the last frame. Repetitions and min_time
-// of 0 leave them to Google Benchmark's flags (--benchmark_repetitions, --benchmark_min_time).
+// untimed whole frame (GPU backends compile the scene's program then; the deterministic counters
+// are its), each timed frame one of its colour alone (Backend::render_colour: what a user waits
+// for; the GPU backends read back nothing else) timed by the backend's own measure where it has
+// one (Backend::last_frame_seconds: webgl's page), else by the clock around it (Google
+// Benchmark's manual time); counters rays_per_s, steps_mean, steps_p99, crossings_mean,
+// out_of_steps, a GPU backend's device times (DeviceTimes) and, for the SIMD backend,
+// lane_utilisation, steps_per_s, peak_steps_per_s and of_peak (simd_counters); a GPU backend's
+// runs are labelled with its device (device_label). `last`, when given, receives the whole frame.
+// Repetitions and min_time of 0 leave them to Google Benchmark's flags (--benchmark_repetitions,
+// --benchmark_min_time).
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
                               const MarchParams& params, int width, int height, int repetitions,
                               double min_time, Frame* last = nullptr, const std::string& name = "");
+
+// A GPU backend's time on its device over a timed case's frames (Backend::last_device_timing):
+// add() after each frame, with the wall time it took; counters() then sets device_ms (the march
+// and the read-back on the device's clock, a frame), march_ms, readback_ms and rest_ms (a frame's
+// wall time less its device time: the submission, the waits and the host's unpacking), each the
+// mean over the frames. Nothing for a backend that runs on no device of its own; where the
+// device has no clock, `why()` says so and no counter is set.
+class DeviceTimes {
+ public:
+  void add(const Backend& backend, double wall_seconds);
+  void counters(benchmark::State& state) const;
+  const std::string& why() const { return why_; }
+
+ private:
+  int frames_ = 0;
+  double march_ = 0.0, readback_ = 0.0, wall_ = 0.0;
+  std::string why_;
+};
 
 // The counters of a timed frame: rays_per_s (a rate over the iterations), and the deterministic
 // figures of the frame: steps_mean, steps_p99, crossings_mean, out_of_steps (share of rays that

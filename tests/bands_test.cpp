@@ -40,5 +40,20 @@ TEST(Bands, AOneBandFirstFrameKeepsThePaceUnknown) {
   EXPECT_DOUBLE_EQ(bands.pace(), 0.0);
 }
 
+TEST(Bands, OnlyProgressOrAGpusWatchdogCutsAFrame) {
+  EXPECT_EQ(banding(true, true), Banding::progress);
+  EXPECT_EQ(banding(true, false), Banding::progress);
+  EXPECT_EQ(banding(false, false), Banding::watchdog);
+  EXPECT_EQ(banding(false, true), Banding::none);
+  // A software rasteriser without progress: one submission, first frame or not.
+  EXPECT_EQ(BandPacer(0.0, 100, 5000, 8, Banding::none).rows(0), 5000);
+  EXPECT_EQ(BandPacer(1.0, 100, 5000, 8, Banding::none).rows(16), 4984);
+  // A GPU: bands of at most 0.2 s at the last frame's pace (2000 rows of 100 pixels at 1 us),
+  // and a first frame starting small, as with progress.
+  EXPECT_EQ(BandPacer(1e-6, 100, 5000, 8, Banding::watchdog).rows(0), 2000);
+  EXPECT_EQ(BandPacer(1e-9, 100, 5000, 8, Banding::watchdog).rows(0), 5000);
+  EXPECT_EQ(BandPacer(0.0, 100, 5000, 8, Banding::watchdog).rows(0), 64);
+}
+
 }  // namespace
 }  // namespace flatmarch

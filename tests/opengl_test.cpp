@@ -47,10 +47,14 @@ TEST(OpenGlShader, ACameraWithinTheBandGetsAShaderWithoutTheEntryIntoIt) {
   EXPECT_FALSE(kernel::within_band(tables, Vec3(0.0, 0.0, std::nextafter(height, 1e9f))));
   EXPECT_FALSE(kernel::within_band(tables, Vec3(0.0, 0.0, -1e-6)));
   const std::string from_band = "#define FLATMARCH_FROM_BAND";
-  EXPECT_NE(kernel::scene_fragment_shader(tables, false, true).find(from_band), std::string::npos);
-  EXPECT_NE(kernel::scene_compute_shader(tables, false, true).find(from_band), std::string::npos);
+  EXPECT_NE(kernel::scene_fragment_shader(tables, {.from_band = true}).find(from_band),
+            std::string::npos);
+  EXPECT_NE(kernel::scene_compute_shader(tables, {.from_band = true}).find(from_band),
+            std::string::npos);
   EXPECT_EQ(kernel::scene_fragment_shader(tables).find(from_band), std::string::npos);
-  EXPECT_EQ(kernel::scene_fragment_shader(tables, true, true).find(from_band), std::string::npos)
+  EXPECT_EQ(
+      kernel::scene_fragment_shader(tables, {.trace = true, .from_band = true}).find(from_band),
+      std::string::npos)
       << "a probe ray may start anywhere";
 }
 

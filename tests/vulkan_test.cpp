@@ -36,7 +36,7 @@ TEST(VulkanShader, EveryGallerySceneCompilesToSpirvWithGlslang) {
         kernel::compile_scene<float>(test::gallery_scene(name), {});
     for (bool trace : {false, true}) {
       const std::vector<uint32_t> spirv =
-          vulkan::compile_compute(kernel::scene_compute_shader(tables, trace));
+          vulkan::compile_compute(kernel::scene_compute_shader(tables, {.trace = trace}));
       ASSERT_GT(spirv.size(), 5u) << name;
       EXPECT_EQ(spirv[0], 0x07230203u) << name << ": not a SPIR-V module";  // its magic number
     }
@@ -55,7 +55,7 @@ TEST(VulkanShader, BakesTheTablesAsPlainArraysAndSpecialises) {
             std::string::npos);
   EXPECT_NE(source.find("layout(local_size_x = TILE, local_size_y = TILE) in;"), std::string::npos);
   EXPECT_EQ(source.find("#define FLATMARCH_TRACE"), std::string::npos);
-  EXPECT_NE(kernel::scene_compute_shader(tables, true).find("#define FLATMARCH_TRACE"),
+  EXPECT_NE(kernel::scene_compute_shader(tables, {.trace = true}).find("#define FLATMARCH_TRACE"),
             std::string::npos);
 }
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/lru_cache.hpp"
+#include "backends/opengl/context.hpp"
 #include "backends/opengl/gl_api.hpp"
 #include "backends/opengl/gl_kernel.hpp"
 #include "kernels/camera.hpp"
@@ -205,6 +206,7 @@ class Viewer {
   };
   LruCache<ProgramKey, std::unique_ptr<gl::KernelProgram>> programs_{kMaxPrograms};
   std::unique_ptr<gl::RenderTargets> targets_;
+  KernelShape shape_ = KernelShape::software;
 };
 
 Viewer& viewer_of(GLFWwindow* window) {
@@ -233,6 +235,12 @@ Viewer::Viewer(const ViewerOptions& options)
     throw Unavailable(std::string("the viewer's window has no OpenGL 4.5 core context: ") +
                       e.what());
   }
+  // The kernel shaped for the window's device: the software shape on llvmpipe (Xvfb), else the
+  // gpu shape's code (the viewer draws a fragment shader either way: into the window).
+  const GLubyte* renderer = gl_.GetString(GL_RENDERER);
+  shape_ = renderer && gl::software_renderer(reinterpret_cast<const char*>(renderer))
+               ? KernelShape::software
+               : KernelShape::gpu;
   // A script runs as fast as it draws; a person gets frames paced by the display.
   glfw().SwapInterval(options.scripted ? 0 : 1);
 
@@ -386,7 +394,7 @@ const gl::KernelProgram& Viewer::program() {
                           ("flatmarch view: " + scene_.name + " | compiling").c_str());
     compiled_ = true;
     return std::make_unique<gl::KernelProgram>(gl_, kernel::compile_scene<float>(scene_, params),
-                                               false);
+                                               kernel::ShaderVariant{.shape = shape_});
   });
 }
 

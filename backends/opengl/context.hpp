@@ -60,6 +60,9 @@ class Context {
   Device device_;
 };
 
+// Whether a renderer string (GL_RENDERER) names a rasteriser on the CPU.
+bool software_renderer(const std::string& renderer);
+
 // What a context offers: OpenGL 4.5 core (the kernel's programs), or the compatibility profile
 // (GLSL 1.20 programs, such as the original web app's shaders that the benchmarks time).
 enum class Profile { core, compatibility };

@@ -21,6 +21,8 @@ using BindTextureProc = void(APIENTRYP)(GLenum target, GLuint texture);
   X(PFNGLGETERRORPROC, GetError)                               \
   X(PFNGLGETSTRINGPROC, GetString)                             \
   X(PFNGLGETINTEGERVPROC, GetIntegerv)                         \
+  X(PFNGLGETINTEGERI_VPROC, GetIntegeri_v)                     \
+  X(PFNGLGETINTEGER64VPROC, GetInteger64v)                     \
   X(PFNGLCREATESHADERPROC, CreateShader)                       \
   X(PFNGLSHADERSOURCEPROC, ShaderSource)                       \
   X(PFNGLCOMPILESHADERPROC, CompileShader)                     \
@@ -78,7 +80,18 @@ using BindTextureProc = void(APIENTRYP)(GLenum target, GLuint texture);
   X(PFNGLCLEARCOLORPROC, ClearColor)                           \
   X(PFNGLCLEARPROC, Clear)                                     \
   X(PFNGLFINISHPROC, Finish)                                   \
-  X(PFNGLLINEWIDTHPROC, LineWidth)
+  X(PFNGLFLUSHPROC, Flush)                                     \
+  X(PFNGLLINEWIDTHPROC, LineWidth)                             \
+  X(PFNGLDISPATCHCOMPUTEPROC, DispatchCompute)                 \
+  X(PFNGLCOPYBUFFERSUBDATAPROC, CopyBufferSubData)             \
+  X(PFNGLMAPBUFFERRANGEPROC, MapBufferRange)                   \
+  X(PFNGLUNMAPBUFFERPROC, UnmapBuffer)                         \
+  X(PFNGLGENQUERIESPROC, GenQueries)                           \
+  X(PFNGLDELETEQUERIESPROC, DeleteQueries)                     \
+  X(PFNGLBEGINQUERYPROC, BeginQuery)                           \
+  X(PFNGLENDQUERYPROC, EndQuery)                               \
+  X(PFNGLGETQUERYIVPROC, GetQueryiv)                           \
+  X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v)
 
 struct Api {
 #define FLATMARCH_GL_MEMBER(type, name) type name = nullptr;

@@ -25,8 +25,11 @@ GLuint compile(const Api& gl, GLenum stage, const std::string& source) {
   gl.GetShaderInfoLog(shader, length, nullptr, log.data());
   gl.DeleteShader(shader);
   log.resize(log.find('\0') == std::string::npos ? log.size() : log.find('\0'));
-  throw kernel::ShaderError(std::string(stage == GL_VERTEX_SHADER ? "vertex" : "fragment") +
-                            " shader does not compile:\n" + kernel::annotate_log(source, log));
+  const char* name = stage == GL_VERTEX_SHADER    ? "vertex"
+                     : stage == GL_COMPUTE_SHADER ? "compute"
+                                                  : "fragment";
+  throw kernel::ShaderError(std::string(name) + " shader does not compile:\n" +
+                            kernel::annotate_log(source, log));
 }
 
 }  // namespace
@@ -56,14 +59,56 @@ GLuint link_program(const Api& gl, const std::string& vertex, const std::string&
   throw kernel::ShaderError("the shader program does not link:\n" + log);
 }
 
-RenderTargets::RenderTargets(const Api& gl, int width, int height)
-    : gl_(gl), width_(width), height_(height) {
+GLuint link_compute(const Api& gl, const std::string& compute) {
+  const GLuint cs = compile(gl, GL_COMPUTE_SHADER, compute);
+  const GLuint program = gl.CreateProgram();
+  gl.AttachShader(program, cs);
+  gl.LinkProgram(program);
+  gl.DeleteShader(cs);
+  GLint ok = GL_FALSE, length = 0;
+  gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (ok == GL_TRUE) return program;
+  gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+  std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
+  gl.GetProgramInfoLog(program, length, nullptr, log.data());
+  gl.DeleteProgram(program);
+  throw kernel::ShaderError("the compute program does not link:\n" + log);
+}
+
+namespace {
+
+// The targets of a readback: their internal formats (0: none).
+struct TargetFormats {
+  GLenum colour, aovs;
+};
+TargetFormats formats(kernel::Readback r) {
+  switch (r) {
+    case kernel::Readback::colour:
+      return {GL_R32UI, 0};
+    case kernel::Readback::all:
+      return {GL_RGBA32F, GL_RGBA32UI};
+    case kernel::Readback::floats:
+      break;
+  }
+  return {GL_RGBA32F, GL_RGBA32F};
+}
+
+}  // namespace
+
+RenderTargets::RenderTargets(const Api& gl, int width, int height, kernel::Readback readback)
+    : gl_(gl), width_(width), height_(height), readback_(readback) {
+  const TargetFormats f = formats(readback);
+  const GLenum internal[2] = {f.colour, f.aovs};
   gl.GenFramebuffers(1, &framebuffer_);
   gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
-  gl.GenTextures(2, textures_);
-  for (int k = 0; k < 2; ++k) {
+  const GLsizei count = f.aovs ? 2 : 1;
+  gl.GenTextures(count, textures_);
+  for (int k = 0; k < count; ++k) {
+    const bool integer = internal[k] != GL_RGBA32F;
     gl.BindTexture(GL_TEXTURE_2D, textures_[k]);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal[k]), width, height, 0,
+                  integer ? (internal[k] == GL_R32UI ? GL_RED_INTEGER : GL_RGBA_INTEGER) : GL_RGBA,
+                  integer ? GL_UNSIGNED_INT : GL_FLOAT, nullptr);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(k),
@@ -72,30 +117,91 @@ RenderTargets::RenderTargets(const Api& gl, int width, int height)
   bind();
   if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    gl.DeleteTextures(2, textures_);
+    gl.DeleteTextures(count, textures_);
     gl.DeleteFramebuffers(1, &framebuffer_);
-    throw std::runtime_error("OpenGL cannot draw to float targets of " + std::to_string(width) +
-                             "x" + std::to_string(height));
+    throw std::runtime_error("OpenGL cannot draw to the frame's targets at " +
+                             std::to_string(width) + "x" + std::to_string(height));
   }
 }
 
 void RenderTargets::bind() const {
   gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
   const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  gl_.DrawBuffers(2, buffers);
+  gl_.DrawBuffers(textures_[1] ? 2 : 1, buffers);
 }
 
 RenderTargets::~RenderTargets() {
   gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
-  gl_.DeleteTextures(2, textures_);
+  gl_.DeleteTextures(textures_[1] ? 2 : 1, textures_);
   gl_.DeleteFramebuffers(1, &framebuffer_);
 }
 
-KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace,
-                             bool from_band)
-    : gl_(gl), trace_(trace) {
+Buffer::Buffer(const Api& gl) : gl_(gl) {
+  gl.GenBuffers(1, &id_);
+}
+
+Buffer::~Buffer() {
+  gl_.DeleteBuffers(1, &id_);
+}
+
+void Buffer::bind(GLenum target, size_t bytes, GLenum usage) {
+  gl_.BindBuffer(target, id_);
+  if (bytes <= size_) return;
+  // Grown by half again at least: frames of growing sizes reallocate rarely.
+  const size_t size = std::max(bytes, size_ + size_ / 2);
+  gl_.BufferData(target, static_cast<GLsizeiptr>(size), nullptr, usage);
+  size_ = size;
+}
+
+DeviceClock::DeviceClock(const Api& gl) : gl_(gl) {
+  GLint bits = 0;
+  gl.GetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
+  if (bits <= 0) {
+    why_ = "the OpenGL device has no timer (GL_TIME_ELAPSED counts 0 bits)";
+    return;
+  }
+  gl.GenQueries(2, queries_);
+}
+
+DeviceClock::~DeviceClock() {
+  if (available()) gl_.DeleteQueries(2, queries_);
+}
+
+void DeviceClock::begin(Span s) {
+  if (!available()) return;
+  settle(s);
+  gl_.BeginQuery(GL_TIME_ELAPSED, queries_[s]);
+}
+
+void DeviceClock::end(Span s) {
+  if (!available()) return;
+  gl_.EndQuery(GL_TIME_ELAPSED);
+  pending_[s] = true;
+}
+
+void DeviceClock::settle(Span s) {
+  if (!pending_[s]) return;
+  GLuint64 ns = 0;
+  gl_.GetQueryObjectui64v(queries_[s], GL_QUERY_RESULT, &ns);
+  seconds_[s] += static_cast<double>(ns) * 1e-9;
+  pending_[s] = false;
+}
+
+DeviceTiming DeviceClock::read() {
+  if (!available()) return {.why = why_};
+  settle(march);
+  settle(readback);
+  const DeviceTiming t{
+      .measured = true, .why = {}, .march_s = seconds_[march], .readback_s = seconds_[readback]};
+  seconds_[march] = seconds_[readback] = 0.0;
+  return t;
+}
+
+KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables,
+                             const kernel::ShaderVariant& variant)
+    : gl_(gl), trace_(variant.trace) {
   program_ = link_program(gl, kernel::kFullScreenVertexShader,
-                          kernel::scene_fragment_shader(tables, trace, from_band));
+                          kernel::scene_fragment_shader(tables, variant));
   polygon_ = gl.GetUniformLocation(program_, "u_polygon");
   from_ = gl.GetUniformLocation(program_, "u_from");
   forward_ = gl.GetUniformLocation(program_, "u_forward");
@@ -105,7 +211,7 @@ KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& ta
   size_ = gl.GetUniformLocation(program_, "u_size");
   rows_ = gl.GetUniformLocation(program_, "u_rows");
   gl.GenVertexArrays(1, &vertex_array_);  // the core profile draws only with one bound
-  if (trace) gl.GenBuffers(1, &events_);
+  if (trace_) gl.GenBuffers(1, &events_);
 }
 
 KernelProgram::~KernelProgram() {
@@ -154,6 +260,30 @@ Trace KernelProgram::trace(const Ray& ray, int max_events) const {
   std::vector<unsigned char> data(bytes);
   gl_.GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(bytes), data.data());
   return shader_trace(data.data(), max_events);
+}
+
+ComputeProgram::ComputeProgram(const Api& gl, const kernel::SceneTables<float>& tables,
+                               const kernel::ShaderVariant& variant)
+    : gl_(gl) {
+  program_ =
+      link_compute(gl, kernel::scene_compute_shader(tables, variant, kernel::ComputeApi::opengl));
+  gl.GenBuffers(1, &constants_);
+  gl.BindBuffer(GL_UNIFORM_BUFFER, constants_);
+  gl.BufferData(GL_UNIFORM_BUFFER, sizeof(kernel::ComputeConstants), nullptr, GL_DYNAMIC_DRAW);
+}
+
+ComputeProgram::~ComputeProgram() {
+  gl_.DeleteProgram(program_);
+  gl_.DeleteBuffers(1, &constants_);
+}
+
+void ComputeProgram::dispatch(const kernel::ComputeConstants& constants, GLuint groups_x,
+                              GLuint tile_rows) const {
+  gl_.UseProgram(program_);
+  gl_.BindBuffer(GL_UNIFORM_BUFFER, constants_);
+  gl_.BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof constants, &constants);
+  gl_.BindBufferBase(GL_UNIFORM_BUFFER, 0, constants_);
+  gl_.DispatchCompute(groups_x, tile_rows, 1);
 }
 
 void draw_frame(const Api& gl, const KernelProgram& program, const CameraBasis<float>& camera,

@@ -1,5 +1,6 @@
-// The kernel as an OpenGL program, for whichever context is current: the OpenGL backend's
-// (OSMesa, headless) and the viewer's (a GLFW window) draw frames with it alike.
+// The kernel as OpenGL programs, for whichever context is current: a fragment program (the
+// software shape; the viewer's window draws with it too) and a compute program (the gpu shape), the
+// targets and buffers their frames go to, and the device's clock that times them.
 #pragma once
 
 #include <stdexcept>
@@ -10,44 +11,94 @@
 #include "backends/opengl/gl_api.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/compile.hpp"
+#include "kernels/scene_shader.hpp"
 #include "kernels/shader_log.hpp"
 
 namespace flatmarch::gl {
 
 // Compiles and links; throws kernel::ShaderError.
 GLuint link_program(const Api& gl, const std::string& vertex, const std::string& fragment);
+GLuint link_compute(const Api& gl, const std::string& compute);
 
-// A framebuffer with two float colour targets of one size, bound for drawing while it lives:
-// attachment 0 the linear colour (rgb, 1), 1 the AOVs (steps, crossings, hit, t), as
-// KernelProgram draws them.
+// A framebuffer with the colour targets of one size that a fragment program of `readback`
+// draws (kernels/scene_shader.hpp), bound for drawing while it lives: floats, attachment 0 the
+// linear colour (RGBA32F) and 1 the AOVs (RGBA32F); all, 0 the colour (RGBA32F) and 1 the
+// integer AOVs (RGBA32UI); colour, 0 alone, the packed sRGB colour (R32UI).
 class RenderTargets {
  public:
-  RenderTargets(const Api& gl, int width, int height);
+  RenderTargets(const Api& gl, int width, int height,
+                kernel::Readback readback = kernel::Readback::floats);
   ~RenderTargets();
   RenderTargets(const RenderTargets&) = delete;
   RenderTargets& operator=(const RenderTargets&) = delete;
   GLuint framebuffer() const { return framebuffer_; }
-  // Binds the framebuffer for drawing to both targets again (after another was bound).
+  // Binds the framebuffer for drawing to its targets again (after another was bound).
   void bind() const;
   GLuint colour() const { return textures_[0]; }
-  GLuint aovs() const { return textures_[1]; }
+  GLuint aovs() const { return textures_[1]; }  // 0 where there are none
   int width() const { return width_; }
   int height() const { return height_; }
+  kernel::Readback readback() const { return readback_; }
 
  private:
   const Api& gl_;
   GLuint framebuffer_ = 0;
   GLuint textures_[2] = {0, 0};
   int width_, height_;
+  kernel::Readback readback_;
 };
 
-// The compiled kernel of one scene and one set of march parameters (both baked in).
+// A buffer object whose storage grows to what is asked of it.
+class Buffer {
+ public:
+  explicit Buffer(const Api& gl);
+  ~Buffer();
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+  // Binds it to `target` with room for at least `bytes` (new storage of `usage` where it had
+  // less; its contents are then undefined).
+  void bind(GLenum target, size_t bytes, GLenum usage);
+  GLuint id() const { return id_; }
+
+ private:
+  const Api& gl_;
+  GLuint id_ = 0;
+  size_t size_ = 0;
+};
+
+// Spans of commands timed on the device's clock (ARB_timer_query's GL_TIME_ELAPSED queries):
+// what the device took for them, without the host's submission and waits. Two spans, the march
+// and the read-back, each summed over its begin()/end() pairs until read().
+class DeviceClock {
+ public:
+  enum Span { march = 0, readback = 1 };
+  explicit DeviceClock(const Api& gl);
+  ~DeviceClock();
+  DeviceClock(const DeviceClock&) = delete;
+  DeviceClock& operator=(const DeviceClock&) = delete;
+  // Whether the device has the clock; why not where it has not.
+  bool available() const { return why_.empty(); }
+  const std::string& why() const { return why_; }
+  void begin(Span s);
+  void end(Span s);
+  // The spans' seconds since the last read(), waiting for what the device has still to report.
+  DeviceTiming read();
+
+ private:
+  void settle(Span s);  // adds a finished span's time to its sum
+  const Api& gl_;
+  std::string why_;
+  GLuint queries_[2] = {0, 0};
+  bool pending_[2] = {false, false};
+  double seconds_[2] = {0.0, 0.0};
+};
+
+// The compiled fragment kernel of one scene, one set of march parameters (both baked in) and one
+// variant (kernels/scene_shader.hpp).
 class KernelProgram {
  public:
-  // `trace`: the variant that marches one probe ray and records its events. `from_band`: one for
-  // cameras within the band only (kernel::scene_fragment_shader).
-  KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables, bool trace,
-                bool from_band = false);
+  KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables,
+                const kernel::ShaderVariant& variant);
   ~KernelProgram();
   KernelProgram(const KernelProgram&) = delete;
   KernelProgram& operator=(const KernelProgram&) = delete;
@@ -57,7 +108,8 @@ class KernelProgram {
   enum class Rows { top_up, top_first };
 
   // Draws the camera's view of a width x height image into the bound framebuffer's draw
-  // buffers 0 (colour) and 1 (AOVs), over its viewport: every pixel within the scissor box.
+  // buffers (RenderTargets of the variant's readback), over its viewport: every pixel within the
+  // scissor box.
   void draw(const CameraBasis<float>& camera, int polygon, glm::vec3 from, int width, int height,
             Rows rows = Rows::top_up) const;
 
@@ -78,10 +130,34 @@ class KernelProgram {
   mutable double seconds_per_pixel_ = 0.0;
 };
 
-// A whole width x height frame of `program` drawn into the bound render targets and read back:
-// in bands of rows (BandPacer, at the program's last pace; `progress` after each), the image's
-// rows top first, so that the read-back is in the frame's order. The colour goes into
-// frame.rgb; the AOVs too where `aovs` is given (read through it, the caller's buffer reused).
+// The compiled compute kernel (kernels/scene_shader.hpp's scene_compute_shader for OpenGL) of one
+// scene, its march parameters and a frame variant: one invocation a pixel, into the buffer at
+// shader storage binding 5.
+class ComputeProgram {
+ public:
+  ComputeProgram(const Api& gl, const kernel::SceneTables<float>& tables,
+                 const kernel::ShaderVariant& variant);
+  ~ComputeProgram();
+  ComputeProgram(const ComputeProgram&) = delete;
+  ComputeProgram& operator=(const ComputeProgram&) = delete;
+
+  // Dispatches one band: `tile_rows` rows of `groups_x` workgroups from row constants.frame.z.
+  void dispatch(const kernel::ComputeConstants& constants, GLuint groups_x, GLuint tile_rows) const;
+
+  double seconds_per_pixel() const { return seconds_per_pixel_; }
+  void set_seconds_per_pixel(double s) const { seconds_per_pixel_ = s; }
+
+ private:
+  const Api& gl_;
+  GLuint program_ = 0, constants_ = 0;
+  mutable double seconds_per_pixel_ = 0.0;
+};
+
+// A whole width x height frame of the floats `program` drawn into the bound floats render
+// targets and read back, as the viewer's screenshots take it: in bands of rows (BandPacer, at the
+// program's last pace; `progress` after each), the image's rows top first, so that the read-back
+// is in the frame's order. The colour goes into frame.rgb; the AOVs too where `aovs` is given
+// (read through it, the caller's buffer reused).
 void draw_frame(const Api& gl, const KernelProgram& program, const CameraBasis<float>& camera,
                 int polygon, glm::vec3 from, const Progress& progress, Frame& frame,
                 std::vector<float>* aovs);

@@ -1,7 +1,10 @@
-// The OpenGL backend: the kernel as a fragment shader (kernels/scene_shader.hpp), specialised per
-// scene with its tables baked in, run headless on the machine's GPU through EGL, or on the CPU
-// (Mesa's llvmpipe, through EGL or OSMesa) where it has none (backends/opengl/context.hpp). Colour
-// and the AOVs are two float render targets read back into the frame. Float32 only.
+// The OpenGL backend: the kernel as a fragment shader (the software shape) or a compute shader
+// (the gpu shape; kernels/scene_shader.hpp), specialised per scene with its tables baked in, run
+// headless on the machine's GPU through EGL, or on the CPU (Mesa's llvmpipe, through EGL or
+// OSMesa) where it has none (backends/opengl/context.hpp). A frame is read back through a
+// buffer: the 8-bit colour alone for a frame of the colour (render_colour), the float colour and
+// the integer AOVs for a whole frame; every frame is timed on the device (timer queries).
+// Float32 only.
 #pragma once
 
 #include <memory>
@@ -29,12 +32,16 @@ class OpenGlBackend final : public Backend {
   std::optional<DeviceInfo> device() const override;
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;
+  Frame render_colour(const Scene& scene, const Camera& camera, int width, int height,
+                      const MarchParams& params, const Progress& progress) const override;
+  std::optional<DeviceTiming> last_device_timing() const override;
   Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
               int max_events) const override;
 
-  // Compiles a fragment shader for this backend's program (with the full-screen vertex shader);
-  // throws kernel::ShaderError with the driver's log and the source lines it names.
-  void compile(const std::string& fragment) const;
+  // Compiles a fragment shader for this backend's program (with the full-screen vertex shader),
+  // or a compute shader; throws kernel::ShaderError with the driver's log and the source lines it
+  // names.
+  void compile(const std::string& source, bool compute = false) const;
 
   // The OpenGL renderer and version of its context ("" when unavailable).
   std::string renderer() const;
@@ -45,6 +52,8 @@ class OpenGlBackend final : public Backend {
   struct Context;            // the context, its GL functions and compiled programs
   Context* context() const;  // null when unavailable (unavailable_ says why)
   void make_context() const;
+  Frame draw(const Scene& scene, const Camera& camera, int width, int height,
+             const MarchParams& params, const Progress& progress, bool colour_only) const;
 
   BackendOptions options_;
   mutable std::once_flag made_;

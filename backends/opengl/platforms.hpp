@@ -24,7 +24,4 @@ std::vector<Candidate> egl_candidates();
 // OSMesa, always software (Mesa's llvmpipe or softpipe).
 Candidate osmesa_candidate();
 
-// Whether a renderer string names a rasteriser on the CPU.
-bool software_renderer(const std::string& renderer);
-
 }  // namespace flatmarch::gl

@@ -22,6 +22,7 @@
 #include "backends/kernel_trace.hpp"
 #include "backends/lru_cache.hpp"
 #include "backends/process_exit.hpp"
+#include "backends/readback.hpp"
 #include "backends/vulkan/spirv.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/scene_shader.hpp"
@@ -32,13 +33,16 @@ namespace {
 
 // Compiled pipelines kept (a pipeline is a scene, its march parameters and a variant).
 constexpr size_t kPipelineCache = 16;
-// How long one band may take before the device is given up on.
+// How long one band may take before the device is given up on, and a whole frame in one
+// submission on a software rasteriser (Banding::none), which has no watchdog and may march a
+// large frame for minutes.
 constexpr uint64_t kBandTimeoutNs = 120'000'000'000;
+constexpr uint64_t kWholeFrameTimeoutNs = 3'600'000'000'000;
+// Timestamps a submission writes: before its dispatch, after it, after the copy to staging.
+constexpr uint32_t kTimestamps = 3;
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 // The storage buffers of kernels/scene_shader.hpp.
 constexpr uint32_t kEventsBinding = 4, kPixelsBinding = 5;
-// Floats a pixel in the pixel buffer: colour (rgb, 1), then the AOVs (steps, crossings, hit, t).
-constexpr size_t kChannels = 8;
 
 std::mutex& messages_mutex() {
   static std::mutex m;
@@ -168,7 +172,16 @@ struct VulkanBackend::Context {
   Buffer pixels, staging, events;
   bool read_directly = false;
   bool force_staging = false;  // BackendOptions::vk_staging
-  std::mutex mutex;            // one frame or trace at a time
+  bool software = false;       // the device is a CPU (lavapipe)
+  KernelShape shape = KernelShape::software;
+  // The device's clock: a pool of kTimestamps queries, its tick in ns and the bits it counts;
+  // or why there is none.
+  vk::raii::QueryPool timestamps = nullptr;
+  double tick_ns = 1.0;
+  uint64_t tick_mask = ~uint64_t{0};
+  std::string no_timestamps;
+  DeviceTiming timing;  // of the last frame
+  std::mutex mutex;     // one frame or trace at a time
   struct CachedPipeline {
     vk::raii::Pipeline pipeline;
     double pace = 0.0;  // of its last frame (BandPacer::pace)
@@ -276,26 +289,32 @@ struct VulkanBackend::Context {
     return vk::raii::Pipeline(device, nullptr, info);
   }
 
-  CachedPipeline& pipeline(const kernel::SceneTables<float>& tables, bool trace,
-                           bool from_band = false) {
-    const std::string source = kernel::scene_compute_shader(tables, trace, from_band);
+  CachedPipeline& pipeline(const kernel::SceneTables<float>& tables,
+                           const kernel::ShaderVariant& variant) {
+    const std::string source = kernel::scene_compute_shader(tables, variant);
     return pipelines.get(source, [&] { return CachedPipeline{make_pipeline(source)}; });
   }
 
-  // Records commands with `record`, runs them and waits for them, at most kBandTimeoutNs.
+  // Records commands with `record`, runs them and waits for them, at most `timeout_ns`.
   template <typename F>
-  void run(F&& record) {
+  void run(F&& record, uint64_t timeout_ns = kBandTimeoutNs) {
     commands.reset();
     commands.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
     record(commands);
     commands.end();
     const vk::CommandBuffer buffer = *commands;
     queue.submit(vk::SubmitInfo({}, {}, buffer), *fence);
-    const vk::Result waited = device.waitForFences(*fence, VK_TRUE, kBandTimeoutNs);
+    const vk::Result waited = device.waitForFences(*fence, VK_TRUE, timeout_ns);
     if (waited == vk::Result::eTimeout)
       throw std::runtime_error("the vulkan device did not finish a dispatch in " +
-                               std::to_string(kBandTimeoutNs / 1'000'000'000) + " s");
+                               std::to_string(timeout_ns / 1'000'000'000) + " s");
     device.resetFences(*fence);
+  }
+
+  // The seconds between timestamps `from` and `to` of the last submission (wrapping at the
+  // clock's valid bits).
+  double between(const std::vector<uint64_t>& ticks, uint32_t from, uint32_t to) const {
+    return static_cast<double>((ticks[to] - ticks[from]) & tick_mask) * tick_ns * 1e-9;
   }
 };
 
@@ -466,8 +485,24 @@ void VulkanBackend::make_context() const {
     c->set = std::move(vk::raii::DescriptorSets(
         c->device, vk::DescriptorSetAllocateInfo(*c->descriptor_pool, set_layout))[0]);
     c->force_staging = options_.vk_staging;
+    c->software = c->physical.getProperties().deviceType == vk::PhysicalDeviceType::eCpu;
+    const std::optional<KernelShape> shape = parse_kernel_shape(options_.kernel_shape, c->software);
+    if (!shape) {
+      unavailable_ =
+          "--kernel-shape: expected auto, software or gpu, got \"" + options_.kernel_shape + "\"";
+      return;
+    }
+    c->shape = *shape;
+    if (const uint32_t bits = families[c->queue_family].timestampValidBits; bits == 0) {
+      c->no_timestamps = "the device's compute queue keeps no timestamps (timestampValidBits 0)";
+    } else {
+      c->timestamps = vk::raii::QueryPool(
+          c->device, vk::QueryPoolCreateInfo({}, vk::QueryType::eTimestamp, kTimestamps));
+      c->tick_ns = c->limits.timestampPeriod;
+      c->tick_mask = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
+    }
     c->reserve_events(shader_trace_bytes(64));
-    c->reserve_pixels(64 * 64 * kChannels * sizeof(float));
+    c->reserve_pixels(64 * 64 * kWholeReadbackBytes);
     context_ = std::move(c);
     driver_loaded();  // after the driver has made its device, threads and exit handlers
   } catch (const vk::SystemError& e) {
@@ -530,7 +565,8 @@ std::optional<DeviceInfo> VulkanBackend::device() const {
       .api = "Vulkan " + d.api,
       .driver = d.driver,
       .platform = std::string("Vulkan") + (context_->read_directly ? "" : ", staging read-back"),
-      .software = d.type == "CPU"};
+      .software = context_->software,
+      .kernel_shape = to_string(context_->shape)};
 }
 
 bool VulkanBackend::reads_through_staging() const {
@@ -556,27 +592,46 @@ void VulkanBackend::compile(const std::string& source) const {
 
 Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width, int height,
                             const MarchParams& params, const Progress& progress) const {
+  return draw(scene, camera, width, height, params, progress, false);
+}
+
+Frame VulkanBackend::render_colour(const Scene& scene, const Camera& camera, int width, int height,
+                                   const MarchParams& params, const Progress& progress) const {
+  return draw(scene, camera, width, height, params, progress, true);
+}
+
+std::optional<DeviceTiming> VulkanBackend::last_device_timing() const {
+  if (!context()) return std::nullopt;
+  const std::lock_guard<std::mutex> lock(context_->mutex);
+  return context_->timing;
+}
+
+Frame VulkanBackend::draw(const Scene& scene, const Camera& camera, int width, int height,
+                          const MarchParams& params, const Progress& progress,
+                          bool colour_only) const {
   check_precision(params);
   if (!context()) unavailable(unavailable_);
   Context& c = *context_;
   if (width <= 0 || height <= 0) throw std::invalid_argument("the image has no pixels");
-  const vk::DeviceSize bytes = static_cast<vk::DeviceSize>(width) *
-                               static_cast<vk::DeviceSize>(height) * kChannels * sizeof(float);
+  const size_t pixel_bytes = colour_only ? kColourReadbackBytes : kWholeReadbackBytes;
+  const vk::DeviceSize bytes =
+      static_cast<vk::DeviceSize>(width) * static_cast<vk::DeviceSize>(height) * pixel_bytes;
   const uint32_t groups_x =
       static_cast<uint32_t>((width + kernel::kComputeTile - 1) / kernel::kComputeTile);
   if (bytes > c.limits.maxStorageBufferRange || groups_x > c.limits.maxComputeWorkGroupCount[0])
-    throw std::invalid_argument(
-        "the vulkan device renders at most " +
-        std::to_string(c.limits.maxStorageBufferRange / (kChannels * sizeof(float))) +
-        " pixels and " +
-        std::to_string(c.limits.maxComputeWorkGroupCount[0] *
-                       static_cast<uint64_t>(kernel::kComputeTile)) +
-        " a row");
+    throw std::invalid_argument("the vulkan device renders at most " +
+                                std::to_string(c.limits.maxStorageBufferRange / pixel_bytes) +
+                                " pixels" + (colour_only ? "" : " with their AOVs") + " and " +
+                                std::to_string(c.limits.maxComputeWorkGroupCount[0] *
+                                               static_cast<uint64_t>(kernel::kComputeTile)) +
+                                " a row");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const ValidationCheck check(validation_);
   const std::lock_guard<std::mutex> lock(c.mutex);
-  Context::CachedPipeline& cached =
-      c.pipeline(tables, false, kernel::within_band(tables, camera.position));
+  Context::CachedPipeline& cached = c.pipeline(
+      tables, {.from_band = kernel::within_band(tables, camera.position),
+               .shape = c.shape,
+               .readback = colour_only ? kernel::Readback::colour : kernel::Readback::all});
   const vk::Pipeline pipeline = *cached.pipeline;
   c.reserve_pixels(bytes);
 
@@ -591,7 +646,10 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
       .scale = glm::vec4(basis.aspect * basis.tan_half_fov, basis.tan_half_fov, 0.0f, 0.0f),
       .frame = glm::ivec4(width, height, 0, camera.polygon),
       .order = glm::ivec4(1, 0, 0, 0)};  // each band's, below
-  BandPacer bands(cached.pace, width, height, kernel::kComputeTile);
+  const Banding why = banding(static_cast<bool>(progress), c.software);
+  BandPacer bands(cached.pace, width, height, kernel::kComputeTile, why);
+  const bool timed = *c.timestamps;
+  DeviceTiming timing{.measured = timed, .why = c.no_timestamps};
   for (int row = 0, rows = 0; row < height; row += rows) {
     rows = bands.rows(row);
     const bool last = row + rows == height;
@@ -600,53 +658,64 @@ Frame VulkanBackend::render(const Scene& scene, const Camera& camera, int width,
         static_cast<uint32_t>((rows + kernel::kComputeTile - 1) / kernel::kComputeTile);
     constants.frame.z = row;
     constants.order.x = kernel::row_stride(static_cast<int>(tile_rows));
-    c.run([&](const vk::raii::CommandBuffer& cmd) {
-      cmd.bindPipeline(vk::PipelineBindPoint::eCompute, pipeline);
-      cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *c.layout, 0, *c.set, {});
-      cmd.pushConstants<kernel::ComputeConstants>(*c.layout, vk::ShaderStageFlagBits::eCompute, 0,
-                                                  constants);
-      cmd.dispatch(groups_x, tile_rows, 1);
-      if (!last) return;
-      // The shader's writes, made visible to the host (through a copy to staging where the
-      // pixels are not host-visible).
-      if (c.read_directly) {
-        const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite,
-                                        vk::AccessFlagBits::eHostRead);
-        cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader,
-                            vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
-        return;
-      }
-      const vk::MemoryBarrier to_copy(vk::AccessFlagBits::eShaderWrite,
-                                      vk::AccessFlagBits::eTransferRead);
-      cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader,
-                          vk::PipelineStageFlagBits::eTransfer, {}, to_copy, {}, {});
-      cmd.copyBuffer(*c.pixels.buffer, *c.staging.buffer, vk::BufferCopy(0, 0, bytes));
-      const vk::MemoryBarrier to_host(vk::AccessFlagBits::eTransferWrite,
-                                      vk::AccessFlagBits::eHostRead);
-      cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eHost,
-                          {}, to_host, {}, {});
-    });
+    const bool copied = last && !c.read_directly;
+    c.run(
+        [&](const vk::raii::CommandBuffer& cmd) {
+          if (timed) {
+            cmd.resetQueryPool(*c.timestamps, 0, kTimestamps);
+            cmd.writeTimestamp(vk::PipelineStageFlagBits::eTopOfPipe, *c.timestamps, 0);
+          }
+          cmd.bindPipeline(vk::PipelineBindPoint::eCompute, pipeline);
+          cmd.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *c.layout, 0, *c.set, {});
+          cmd.pushConstants<kernel::ComputeConstants>(*c.layout, vk::ShaderStageFlagBits::eCompute,
+                                                      0, constants);
+          cmd.dispatch(groups_x, tile_rows, 1);
+          if (timed)
+            cmd.writeTimestamp(vk::PipelineStageFlagBits::eComputeShader, *c.timestamps, 1);
+          if (!last) return;
+          // The shader's writes, made visible to the host (through a copy to staging where the
+          // pixels are not host-visible).
+          if (c.read_directly) {
+            const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite,
+                                            vk::AccessFlagBits::eHostRead);
+            cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader,
+                                vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+            return;
+          }
+          const vk::MemoryBarrier to_copy(vk::AccessFlagBits::eShaderWrite,
+                                          vk::AccessFlagBits::eTransferRead);
+          cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader,
+                              vk::PipelineStageFlagBits::eTransfer, {}, to_copy, {}, {});
+          cmd.copyBuffer(*c.pixels.buffer, *c.staging.buffer, vk::BufferCopy(0, 0, bytes));
+          if (timed) cmd.writeTimestamp(vk::PipelineStageFlagBits::eTransfer, *c.timestamps, 2);
+          const vk::MemoryBarrier to_host(vk::AccessFlagBits::eTransferWrite,
+                                          vk::AccessFlagBits::eHostRead);
+          cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer,
+                              vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+        },
+        why == Banding::none ? kWholeFrameTimeoutNs : kBandTimeoutNs);
     bands.done(rows,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (timed) {
+      const uint32_t written = copied ? 3 : 2;
+      const auto [result, ticks] = c.timestamps.getResults<uint64_t>(
+          0, written, written * sizeof(uint64_t), sizeof(uint64_t),
+          vk::QueryResultFlagBits::e64 | vk::QueryResultFlagBits::eWait);
+      if (result == vk::Result::eSuccess) {
+        timing.march_s += c.between(ticks, 0, 1);
+        if (copied) timing.readback_s += c.between(ticks, 1, 2);
+      } else {
+        timing = {.why = "the device's timestamps were not ready (" + vk::to_string(result) + ")"};
+      }
+    }
     if (progress) progress(static_cast<double>(row + rows) / height);
   }
   cached.pace = bands.pace();
+  c.timing = timing;
 
-  Frame frame(width, height);
-  const auto* planes =
-      static_cast<const float*>(c.read_directly ? c.pixels.mapped : c.staging.mapped);
-  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
-  for (size_t px = 0; px < n; ++px) {
-    const float* col = planes + 4 * px;
-    const float* a = planes + 4 * (n + px);
-    frame.rgb[3 * px] = col[0];
-    frame.rgb[3 * px + 1] = col[1];
-    frame.rgb[3 * px + 2] = col[2];
-    frame.steps[px] = a[0];
-    frame.crossings[px] = a[1];
-    frame.hit[px] = a[2];
-    frame.t[px] = a[3];
-  }
+  const void* mapped = c.read_directly ? c.pixels.mapped : c.staging.mapped;
+  Frame frame =
+      colour_only ? colour_frame(mapped, width, height) : whole_frame(mapped, width, height);
   check.done();
   return frame;
 }
@@ -660,7 +729,7 @@ Trace VulkanBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   const ValidationCheck check(validation_);
   const std::lock_guard<std::mutex> lock(c.mutex);
-  const vk::Pipeline pipeline = *c.pipeline(tables, true).pipeline;
+  const vk::Pipeline pipeline = *c.pipeline(tables, {.trace = true, .shape = c.shape}).pipeline;
   const size_t bytes = shader_trace_bytes(max_events);
   c.reserve_events(bytes);
   const ShaderEventHeader header{0, max_events, 0, 0};

@@ -1,8 +1,9 @@
 // The Vulkan backend: the kernel as a compute shader (kernels/scene_shader.hpp), specialised per
 // scene with its tables baked in, compiled to SPIR-V with glslang at run time, on any Vulkan
 // device: a GPU where there is one, Mesa's lavapipe (on the CPU) where there is none. Colour and
-// the AOVs are written to a storage buffer and read back.
-// Float32 only.
+// the AOVs are written to a storage buffer and read back: the 8-bit colour alone for a frame of
+// the colour (render_colour), the float colour and the integer AOVs for a whole frame. Every
+// frame is also timed on the device (timestamp queries). Float32 only.
 #pragma once
 
 #include <memory>
@@ -47,6 +48,9 @@ class VulkanBackend final : public Backend {
   std::optional<DeviceInfo> device() const override;
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;
+  Frame render_colour(const Scene& scene, const Camera& camera, int width, int height,
+                      const MarchParams& params, const Progress& progress) const override;
+  std::optional<DeviceTiming> last_device_timing() const override;
   Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
               int max_events) const override;
 
@@ -68,6 +72,8 @@ class VulkanBackend final : public Backend {
   struct Context;            // the instance, device, buffers and compiled pipelines
   Context* context() const;  // null when unavailable (unavailable_ says why)
   void make_context() const;
+  Frame draw(const Scene& scene, const Camera& camera, int width, int height,
+             const MarchParams& params, const Progress& progress, bool colour_only) const;
 
   BackendOptions options_;
   bool validation_;

@@ -195,12 +195,15 @@ std::optional<DeviceInfo> WebGlBackend::device() const {
   const bool software = renderer.find("SwiftShader") != std::string::npos ||
                         renderer.find("llvmpipe") != std::string::npos ||
                         renderer.find("Software") != std::string::npos;
-  return DeviceInfo{.name = renderer,
-                    .type = software ? "CPU" : "GPU",
-                    .api = info.value("version", std::string()),
-                    .driver = browser_name(session_->browser->product()),
-                    .platform = "headless Chromium",
-                    .software = software};
+  return DeviceInfo{
+      .name = renderer,
+      .type = software ? "CPU" : "GPU",
+      .api = info.value("version", std::string()),
+      .driver = browser_name(session_->browser->product()),
+      .platform = "headless Chromium",
+      .software = software,
+      .kernel_shape = to_string(
+          parse_kernel_shape(options_.kernel_shape, software).value_or(KernelShape::software))};
 }
 
 Frame WebGlBackend::render(const Scene& scene, const Camera& camera, int width, int height,

@@ -1,9 +1,10 @@
 // Every way a GPU backend reaches the same device gives the same frame, to the bit: the OpenGL
 // backend's context made through EGL and through OSMesa on Mesa's llvmpipe, and the Vulkan
 // backend's frames read back directly and through a staging copy (the path a discrete GPU takes,
-// forced with --vk-staging). Every gallery scene (and conformance/scenes) and method, at the
-// conformance suite's size. Labelled `conformance`; a path this machine lacks is skipped, with
-// the reason.
+// forced with --vk-staging); and both kernel shapes (--kernel-shape software and gpu: on OpenGL a
+// fragment and a compute shader) give the same steps, crossings and hits. Every gallery scene (and
+// conformance/scenes) and method, at the conformance suite's size. Labelled `conformance`; a path
+// this machine lacks is skipped, with the reason.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -59,13 +60,15 @@ std::optional<gl::Device> llvmpipe_device(const std::string& platform) {
 
 struct OpenGlPaths {
   std::optional<gl::Device> egl = llvmpipe_device("EGL"), osmesa = llvmpipe_device("OSMesa");
-  std::unique_ptr<OpenGlBackend> through_egl, through_osmesa;
+  std::unique_ptr<OpenGlBackend> through_egl, through_osmesa, gpu_shape;
   OpenGlPaths() {
     if (!egl || !osmesa) return;
-    through_egl =
-        std::make_unique<OpenGlBackend>(BackendOptions{.device = std::to_string(egl->index)});
-    through_osmesa =
-        std::make_unique<OpenGlBackend>(BackendOptions{.device = std::to_string(osmesa->index)});
+    through_egl = std::make_unique<OpenGlBackend>(
+        BackendOptions{.device = std::to_string(egl->index), .kernel_shape = "software"});
+    through_osmesa = std::make_unique<OpenGlBackend>(
+        BackendOptions{.device = std::to_string(osmesa->index), .kernel_shape = "software"});
+    gpu_shape = std::make_unique<OpenGlBackend>(
+        BackendOptions{.device = std::to_string(egl->index), .kernel_shape = "gpu"});
   }
 };
 
@@ -75,8 +78,10 @@ const OpenGlPaths& opengl_paths() {
 }
 
 struct VulkanPaths {
-  VulkanBackend direct{BackendOptions{.validation = true}};
-  VulkanBackend staging{BackendOptions{.vk_staging = true, .validation = true}};
+  VulkanBackend direct{BackendOptions{.kernel_shape = "software", .validation = true}};
+  VulkanBackend staging{
+      BackendOptions{.kernel_shape = "software", .vk_staging = true, .validation = true}};
+  VulkanBackend gpu_shape{BackendOptions{.kernel_shape = "gpu", .validation = true}};
 };
 
 const VulkanPaths& vulkan_paths() {
@@ -102,6 +107,13 @@ void expect_identical(const Frame& a, const Frame& b) {
   expect_identical(a.rgb, b.rgb, "colour");
 }
 
+// The kernel's two shapes: the same rays, each taking the same steps to the same end.
+void expect_same_rays(const Frame& software, const Frame& gpu) {
+  expect_identical(software.hit, gpu.hit, "hit");
+  expect_identical(software.steps, gpu.steps, "steps");
+  expect_identical(software.crossings, gpu.crossings, "crossings");
+}
+
 class DevicePaths : public testing::TestWithParam<Case> {
  protected:
   const Scene& scene() const { return scene_named(GetParam().scene); }
@@ -122,6 +134,15 @@ TEST_P(DevicePaths, OpenGlThroughEglAndOsMesaAgreeOnLlvmpipe) {
   expect_identical(a, b);
 }
 
+TEST_P(DevicePaths, OpenGlKernelShapesMarchAlikeOnLlvmpipe) {
+  const OpenGlPaths& gl = opengl_paths();
+  if (!gl.egl) GTEST_SKIP() << "EGL makes no context on llvmpipe here (see `flatmarch backends`)";
+  const Scene& s = scene();
+  const Frame a = gl.through_egl->render(s, s.camera, kWidth, kHeight, params(), {});
+  const Frame b = gl.gpu_shape->render(s, s.camera, kWidth, kHeight, params(), {});
+  expect_same_rays(a, b);
+}
+
 TEST_P(DevicePaths, VulkanDirectAndStagingReadBacksAgree) {
   const VulkanPaths& vk = vulkan_paths();
   if (const Availability a = vk.direct.availability(); !a.available)
@@ -133,6 +154,16 @@ TEST_P(DevicePaths, VulkanDirectAndStagingReadBacksAgree) {
   const Frame a = vk.direct.render(s, s.camera, kWidth, kHeight, params(), {});
   const Frame b = vk.staging.render(s, s.camera, kWidth, kHeight, params(), {});
   expect_identical(a, b);
+}
+
+TEST_P(DevicePaths, VulkanKernelShapesMarchAlike) {
+  const VulkanPaths& vk = vulkan_paths();
+  if (const Availability a = vk.direct.availability(); !a.available)
+    GTEST_SKIP() << "the vulkan backend is unavailable here: " << a.reason;
+  const Scene& s = scene();
+  const Frame a = vk.direct.render(s, s.camera, kWidth, kHeight, params(), {});
+  const Frame b = vk.gpu_shape.render(s, s.camera, kWidth, kHeight, params(), {});
+  expect_same_rays(a, b);
 }
 
 std::vector<Case> cases() {
