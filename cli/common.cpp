@@ -17,6 +17,7 @@
 #include "backends/oracle/oracle.hpp"
 #include "backends/simd/simd.hpp"
 #include "kernels/compile.hpp"
+#include "output/image_library.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::cli {
@@ -142,6 +143,9 @@ void add_backend_options(CLI::App& app, BackendOptions& options) {
 
 void check_backend_options(const BackendOptions& options) {
   if (options.threads < 0) throw UsageError("--threads: must be 0 (all cores) or more");
+  if (!parse_kernel_shape(options.kernel_shape, false))
+    throw UsageError("--kernel-shape: expected auto, software or gpu, got \"" +
+                     options.kernel_shape + "\"");
   const std::vector<std::string> isas = simd::isa_names(false);
   if (!options.isa.empty() && std::find(isas.begin(), isas.end(), options.isa) == isas.end()) {
     throw UsageError("--isa: unknown instruction set \"" + options.isa + "\" (" + joined(isas) +
@@ -306,6 +310,21 @@ std::vector<Scene> load_scenes(const std::vector<std::string>& names,
   for (const fs::path& f : files) scenes.push_back(load_scene(f));
   return scenes;
 }
+
+std::string image_module_missing() {
+  std::string why;
+  return image_library_if_loadable(&why) ? std::string() : why;
+}
+
+void say_left_out(const std::string& command, const std::string& what, const std::string& how) {
+  std::string why = image_module_missing();
+  for (size_t at; (at = why.find("\n  ")) != std::string::npos;) why.replace(at, 3, " ");
+  std::fprintf(stderr, "%s: left out, %s: no image library here (%s). %s\n", command.c_str(),
+               what.c_str(), why.c_str(), how.c_str());
+}
+
+const char* const kPerceptualLeftOut =
+    "Every other figure is measured, and the verdicts are the other checks'";
 
 std::string joined(const std::vector<std::string>& words) {
   std::string text;

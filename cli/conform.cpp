@@ -124,7 +124,9 @@ void add_conform(CLI::App& app) {
     }
 
     conformance::Suite suite(thresholds);
-    if (!o->error_images.empty()) {
+    const std::string no_images = image_module_missing();
+    const bool error_images = !o->error_images.empty() && no_images.empty();
+    if (error_images) {
       std::error_code error;
       fs::create_directories(o->error_images, error);
       if (error)
@@ -196,7 +198,7 @@ void add_conform(CLI::App& app) {
           failed += r.verdict == conformance::Verdict::fail;
           limits += r.verdict == conformance::Verdict::limit;
           out["cases"].push_back(conformance::to_json(r));
-          if (!o->error_images.empty()) {
+          if (error_images) {
             const fs::path file =
                 fs::path(o->error_images) / (name + "-" + scene.name + "-" + to_string(m) + ".png");
             write_png(
@@ -224,9 +226,20 @@ void add_conform(CLI::App& app) {
           std::fflush(stdout);
         }
     }
+    if (!no_images.empty())
+      out["unmeasured"] = {{"check", "image.perceptual_failpercent"}, {"why", no_images}};
     std::ofstream(o->json) << out.dump(1) << "\n";
     std::printf("%d cases: %d pass, %d at their method's limit, %d failed; wrote %s\n", cases,
                 cases - failed - limits, limits, failed, o->json.c_str());
+    if (!no_images.empty())
+      say_left_out("conform",
+                   o->error_images.empty() ? "Yee's perceptual check"
+                                           : "Yee's perceptual check and the error images",
+                   std::string(kPerceptualLeftOut) +
+                       (o->error_images.empty()
+                            ? ""
+                            : "; `flatmarch conform --error-images DIR` on a machine with "
+                              "OpenImageIO (ci/install-deps.sh installs it) draws the images"));
     if (failed)
       throw ConformanceFailure(std::to_string(failed) + " of " + std::to_string(cases) +
                                " cases failed");

@@ -93,6 +93,39 @@ void merge_report_shards(const Files& files, const fs::path& out, const std::str
   if (!baseline.empty()) gate(results, baseline, folder_of(out));
 }
 
+// One whole run of `flatmarch report`, not sharded (one measured where the images could not be
+// drawn, say: a GPU machine without OpenImageIO), into `out` with what is drawn here: the
+// recommended gallery, the regression section (and the gate) and the page.
+void finish_report(const Files& files, const fs::path& out, const std::string& baseline,
+                   const std::vector<std::string>& galleries, bool html,
+                   const std::string& python) {
+  json results = files.front().second;
+  for (const char* key : {"fingerprint", "matrix", "ranking", "recommendation"})
+    if (!results.contains(key))
+      throw UsageError(files.front().first + ": has no \"" + std::string(key) +
+                       "\": not the results of a whole `flatmarch report`");
+  const fs::path images = folder_of(out) / "images";
+  gather_images(files, images);
+  if (html) {
+    draw_gallery(results, galleries, images);
+    if (results.contains("left_out") && results.contains("gallery"))
+      results["left_out"]["drawn_by_merge"] = {{"gallery",
+                                                "the recommended gallery, by this "
+                                                "machine's backends"},
+                                               {"host", reports::machine_of(results)}};
+  }
+  results["regression"] = regression_section(results, baseline);
+  write_json(out, results);
+  std::fprintf(stderr, "merge: one whole run of `flatmarch report`, %zu matrix cases; wrote %s\n",
+               results["matrix"]["cases"].size(), out.c_str());
+  std::printf("%s", reports::describe_selection(results, "").c_str());
+  if (html) {
+    make_report_page(python, {out.string()}, folder_of(out), "");
+    std::printf("merge: open %s\n", (folder_of(out) / "index.html").c_str());
+  }
+  if (!baseline.empty()) gate(results, baseline, folder_of(out));
+}
+
 // Shards of `flatmarch report`: one machine's merged into `out`; several kinds of machine's each
 // into OUT-MACHINE.json (no gate: it judges one machine) and a page comparing them.
 void merge_reports(Files docs, const fs::path& out, const std::string& baseline,
@@ -152,7 +185,10 @@ void add_merge(CLI::App& app) {
       "recommendation and the sweep's analysis; their images gathered beside -o, the\n"
       "recommended gallery drawn, the regression gate (--baseline: exit 1 on a regression) and\n"
       "the page. Report shards from several kinds of machine merge per machine, into\n"
-      "OUTPUT-MACHINE.json each and a page comparing the machines.");
+      "OUTPUT-MACHINE.json each and a page comparing the machines. One whole run's results.json\n"
+      "(not sharded) gets the same: a run measured where the images could not be drawn (no\n"
+      "OpenImageIO there) is finished here, the recommended gallery drawn by this machine's\n"
+      "backends.");
   struct Options {
     std::vector<std::string> files;
     // The run's scenes, named in its results: here, else in the source tree's gallery.
@@ -195,6 +231,11 @@ void add_merge(CLI::App& app) {
         docs.front().second.is_object() ? docs.front().second.value("format", "") : "";
     const fs::path out(o->out);
     try {
+      if (format == "flatmarch-report/1" && docs.size() == 1 &&
+          !docs.front().second.contains("shard")) {
+        finish_report(docs, out, o->baseline, o->galleries, !o->no_html, o->python);
+        return;
+      }
       if (format == "flatmarch-report/1") {
         merge_reports(std::move(docs), out, o->baseline, o->galleries, !o->no_html, o->python);
         return;

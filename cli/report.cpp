@@ -251,7 +251,9 @@ void add_report(CLI::App& app) {
       throw UsageError("--min-time: expected seconds in (0, 10]");
     r.matrix.min_time = o->min_time;
     r.matrix.conformance = true;
-    r.matrix.images = o->no_html ? fs::path() : fs::path(o->out) / "images";
+    // Images are a by-product: without the image module the figures are measured all the same.
+    const std::string no_images = image_module_missing();
+    r.matrix.images = o->no_html || !no_images.empty() ? fs::path() : fs::path(o->out) / "images";
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
 
     r.sweep_enabled = !o->no_sweep;
@@ -295,9 +297,29 @@ void add_report(CLI::App& app) {
     StageProgress progress{o->quiet, "", nullptr};
     json results = reports::run_report(scenes, r, std::ref(progress));
     if (progress.reporter) progress.reporter->done();
+    if (!no_images.empty())
+      results["left_out"] = {
+          {"what", o->no_html ? json::array({"image.perceptual_failpercent"})
+                              : json::array({"image.perceptual_failpercent", "images"})},
+          {"why", no_images}};
+    const auto say = [&](const fs::path& file) {
+      if (no_images.empty()) return;
+      say_left_out("report",
+                   o->no_html ? "Yee's perceptual check"
+                              : "Yee's perceptual check, each backend's frames and the "
+                                "recommended gallery",
+                   std::string(kPerceptualLeftOut) +
+                       (o->no_html ? ""
+                                   : "; on a machine with OpenImageIO (ci/install-deps.sh), "
+                                     "`flatmarch merge " +
+                                         file.string() +
+                                         " -o DIR/results.json` draws the recommended gallery "
+                                         "and the page from these results"));
+    };
     if (r.shard) {
       const fs::path file = fs::path(o->out) / "results.json";
       write_json(file, results);
+      say(file);
       std::printf(
           "report: shard %s: wrote %s; put the shards together with `flatmarch merge "
           "SHARD.../results.json -o OUT/results.json`\n",
@@ -309,6 +331,7 @@ void add_report(CLI::App& app) {
     write_json(file, results);
     std::printf("%s", reports::describe_selection(results, "").c_str());
     std::printf("report: wrote %s\n", file.c_str());
+    say(file);
     if (!o->write_baseline.empty()) {
       write_json(o->write_baseline, reports::make_baseline(results));
       std::printf("report: wrote the baseline %s\n", o->write_baseline.c_str());

@@ -105,6 +105,10 @@ void add_sweep(CLI::App& app) {
     for (Precision p : o->sweep.precisions)
       result["options"]["precisions"].push_back(p == Precision::f32 ? "f32" : "f64");
     if (!shard.is_null()) result["shard"] = shard;
+    const std::string no_images = image_module_missing();
+    if (!no_images.empty())
+      result["left_out"] = {{"what", json::array({"image.perceptual_failpercent"})},
+                            {"why", no_images}};
     write_json(o->json, result);
     std::printf("%-12s %-9s %-4s %7s  %-26s %s\n", "surface", "method", "prec", "stable",
                 "recommended eps / offset", "pareto front (eps, offset: ms, hit mismatch %)");
@@ -131,6 +135,7 @@ void add_sweep(CLI::App& app) {
                   g["stable"].size(), g["grid"].size(), rec.c_str(), front.c_str());
     }
     std::printf("wrote %s\n", o->json.c_str());
+    if (!no_images.empty()) say_left_out("sweep", "Yee's perceptual check", kPerceptualLeftOut);
   });
 }
 

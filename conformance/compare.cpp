@@ -94,21 +94,48 @@ ImageComparison compare_images(const Frame& got, const Frame& truth,
       ++c.masked;
       for (size_t k = 0; k < 3; ++k) masked.rgb[3 * px + k] = truth.rgb[3 * px + k];
     }
-  const ColourComparison r = image_library().compare(masked, truth, static_cast<float>(t.fail),
-                                                     static_cast<float>(t.warn));
-  c.mean_error = r.mean_error;
-  c.rms_error = r.rms_error;
-  c.psnr = r.psnr;
-  c.max_error = r.max_error;
-  c.max_x = r.max_x;
-  c.max_y = r.max_y;
-  c.warn = r.warn;
-  c.fail = r.fail;
-  c.perceptual = r.perceptual;
+  // idiff's figures (OpenImageIO's ImageBufAlgo::compare, as its documentation defines them): a
+  // channel's difference |a - b|; a pixel warns, or fails, where one of its channels differs by
+  // more than the threshold (a NaN difference too); the mean and RMS of the differences over
+  // every channel, the PSNR against a peak of 1, and the largest difference with the first
+  // pixel that has it. Summed in double, row by row (compare_test holds them to OpenImageIO's).
+  double total = 0.0, squares = 0.0;
+  const int width = std::max(truth.width, 1);
+  for (size_t px = 0; px < c.pixels; ++px) {
+    bool warned = false, failed = false;
+    double row_total = 0.0, row_squares = 0.0;
+    for (size_t k = 0; k < 3; ++k) {
+      const double f = std::abs(masked.rgb[3 * px + k] - truth.rgb[3 * px + k]);
+      row_total += f;
+      row_squares += f * f;
+      if (!(f <= c.max_error)) {
+        c.max_error = f;
+        c.max_x = static_cast<int>(px % static_cast<size_t>(width));
+        c.max_y = static_cast<int>(px / static_cast<size_t>(width));
+      }
+      warned |= !(f <= t.warn);
+      failed |= !(f <= t.fail);
+    }
+    total += row_total;
+    squares += row_squares;
+    c.warn += warned;
+    c.fail += failed;
+  }
+  const double values = 3.0 * static_cast<double>(std::max<size_t>(c.pixels, 1));
+  c.mean_error = total / values;
+  c.rms_error = std::sqrt(squares / values);
+  c.psnr = 20.0 * std::log10(1.0 / c.rms_error);
+  // Yee's metric is OpenImageIO's alone: where the image module cannot be loaded it is not
+  // measured, and the case says so (CaseResult::unmeasured).
+  if (const ImageLibrary* images = image_library_if_loadable(&c.perceptual_why)) {
+    c.perceptual = images->perceptual(masked, truth);
+    c.perceptual_measured = true;
+  }
   const double percent = 100.0 / static_cast<double>(std::max<size_t>(c.pixels, 1));
   c.failed = static_cast<double>(c.fail) * percent > t.failpercent || c.max_error > t.hardfail;
   c.warned = static_cast<double>(c.warn) * percent > t.warnpercent;
-  c.perceptual_failed = static_cast<double>(c.perceptual) * percent > t.perceptual_failpercent;
+  c.perceptual_failed = c.perceptual_measured &&
+                        static_cast<double>(c.perceptual) * percent > t.perceptual_failpercent;
   return c;
 }
 

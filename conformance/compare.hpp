@@ -38,7 +38,8 @@ std::optional<Failure> classify(int hit, int crossings, int want, int want_cross
 // --- Images, as OpenImageIO's idiff: a pixel fails when a channel differs by more than `fail`,
 // warns above `warn`; the image fails when more than failpercent % of its pixels fail (or any
 // pixel differs by more than hardfail), warns likewise. The perceptual metric is Yee's
-// (ImageBufAlgo::compare_Yee): the share of pixels whose difference a viewer would see.
+// (ImageBufAlgo::compare_Yee, through the image module): the share of pixels whose difference a
+// viewer would see; not measured where the module cannot be loaded.
 struct ImageThresholds {
   double fail = 0.05, failpercent = 1.0, hardfail = 1.0;
   double warn = 0.01, warnpercent = 5.0;
@@ -47,9 +48,11 @@ struct ImageThresholds {
 
 struct ImageComparison {
   double mean_error = 0.0, rms_error = 0.0, psnr = 0.0, max_error = 0.0;
-  int max_x = 0, max_y = 0;       // where the largest difference is
-  size_t warn = 0, fail = 0;      // pixels over the thresholds
-  size_t perceptual = 0;          // pixels Yee's metric tells apart
+  int max_x = 0, max_y = 0;   // where the largest difference is
+  size_t warn = 0, fail = 0;  // pixels over the thresholds
+  size_t perceptual = 0;      // pixels Yee's metric tells apart
+  bool perceptual_measured = false;
+  std::string perceptual_why;     // why not, where it was not
   size_t pixels = 0, masked = 0;  // masked: ambiguous pixels, left out
   bool failed = false, warned = false, perceptual_failed = false;
 };

@@ -307,9 +307,12 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   add_check(r, "image.failpercent", 100.0 * static_cast<double>(r.image.fail) / pixels,
             t.image.failpercent, false);
   add_check(r, "image.max_error", r.image.max_error, t.image.hardfail, false);
-  add_check(r, "image.perceptual_failpercent",
-            100.0 * static_cast<double>(r.image.perceptual) / pixels,
-            t.image.perceptual_failpercent, false);
+  if (r.image.perceptual_measured)
+    add_check(r, "image.perceptual_failpercent",
+              100.0 * static_cast<double>(r.image.perceptual) / pixels,
+              t.image.perceptual_failpercent, false);
+  else
+    r.unmeasured.push_back("image.perceptual_failpercent");
   if (r.image.warned)
     r.warnings.push_back(std::to_string(r.image.warn) + " pixels differ by more than " +
                          std::to_string(t.image.warn));
@@ -373,6 +376,15 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   }
   judge(r, unpushed);
   return r;
+}
+
+json unmeasured_json(const CaseResult& r) {
+  json checks = json::array();
+  for (const std::string& name : r.unmeasured)
+    checks.push_back(
+        {{"check", name},
+         {"why", name == "image.perceptual_failpercent" ? r.image.perceptual_why : std::string()}});
+  return checks;
 }
 
 json to_json(const CaseResult& r) {
@@ -450,7 +462,7 @@ json to_json(const CaseResult& r) {
         {"max_at", {r.image.max_x, r.image.max_y}},
         {"warn", r.image.warn},
         {"fail", r.image.fail},
-        {"perceptual", r.image.perceptual}}},
+        {"perceptual", r.image.perceptual_measured ? json(r.image.perceptual) : json(nullptr)}}},
       {"steps", stats(r.steps)},
       {"reference_steps", stats(r.reference_steps)},
       {"steps_ks", r.steps_ks},
@@ -459,6 +471,7 @@ json to_json(const CaseResult& r) {
       {"checks", checks},
       {"colour", colour},
       {"warnings", r.warnings},
+      {"unmeasured", unmeasured_json(r)},
       {"thresholds", to_json(r.thresholds)}};
 }
 

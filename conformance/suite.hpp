@@ -48,6 +48,9 @@ struct CaseResult {
   std::vector<TraceComparison> traces;
   FailureCounts trace_failures{};
   std::vector<Check> checks;
+  // Checks left out where what they need is missing here (Yee's metric without the image
+  // module: ImageComparison::perceptual_why), by name; the verdict is the other checks'.
+  std::vector<std::string> unmeasured;
   std::vector<std::string> warnings;
   bool passed = true;  // every check within its threshold
   Verdict verdict = Verdict::pass;
@@ -115,5 +118,7 @@ class Suite {
 };
 
 nlohmann::json to_json(const CaseResult& r);
+// The checks a case left out and why, [{"check", "why"}] (CaseResult::unmeasured).
+nlohmann::json unmeasured_json(const CaseResult& r);
 
 }  // namespace flatmarch::conformance

@@ -18,8 +18,9 @@ namespace {
 // Where the module may be, in the order tried.
 std::vector<std::string> module_paths() {
   std::vector<std::string> paths;
+  // Set, the folder is the only place looked in: a test makes the module unloadable so.
   if (const char* dir = std::getenv("FLATMARCH_MODULE_DIR"); dir != nullptr && *dir != '\0')
-    paths.push_back(std::string(dir) + "/flatmarch_image.so");
+    return {std::string(dir) + "/flatmarch_image.so"};
   paths.push_back(std::string(FLATMARCH_MODULE_DIR) + "/flatmarch_image.so");
   if (const std::string dir = program_directory(); !dir.empty())
     paths.push_back(dir + "/../lib/flatmarch_image.so");
@@ -56,7 +57,7 @@ const ImageLibrary* load() {
 
 }  // namespace
 
-const ImageLibrary& image_library() {
+const ImageLibrary* image_library_if_loadable(std::string* why) {
   static const std::pair<const ImageLibrary*, std::string> loaded = []() {
     try {
       return std::pair<const ImageLibrary*, std::string>(load(), "");
@@ -64,8 +65,15 @@ const ImageLibrary& image_library() {
       return std::pair<const ImageLibrary*, std::string>(nullptr, e.what());
     }
   }();
-  if (loaded.first == nullptr) throw std::runtime_error(loaded.second);
-  return *loaded.first;
+  if (why) *why = loaded.second;
+  return loaded.first;
+}
+
+const ImageLibrary& image_library() {
+  std::string why;
+  const ImageLibrary* library = image_library_if_loadable(&why);
+  if (library == nullptr) throw std::runtime_error(why);
+  return *library;
 }
 
 std::filesystem::path aov_path(const std::filesystem::path& png) {

@@ -2,7 +2,9 @@
 // Debian's libOpenImageIO brings about 250 shared libraries (codecs, OpenCV, GDAL, ...) whose
 // loading takes about 0.2 s, so only the commands that read, write or compare images load it,
 // when they first do. The module's functions take and return plain frames; they throw
-// std::runtime_error with OpenImageIO's message.
+// std::runtime_error with OpenImageIO's message. A machine may lack the library (a GPU machine
+// lent for minutes, say): the report, the conformance suite, the sweep and the benchmarks
+// measure there without it, and leave out only the images and Yee's perceptual metric.
 #pragma once
 
 #include <cstddef>
@@ -13,14 +15,6 @@
 #include "backends/backend.hpp"
 
 namespace flatmarch {
-
-// OpenImageIO's comparison of two colour images (ImageBufAlgo::compare, as idiff) and the
-// number of pixels Yee's perceptual metric tells apart (ImageBufAlgo::compare_Yee).
-struct ColourComparison {
-  double mean_error = 0.0, rms_error = 0.0, psnr = 0.0, max_error = 0.0;
-  int max_x = 0, max_y = 0;
-  size_t warn = 0, fail = 0, perceptual = 0;
-};
 
 struct ImageLibrary {
   int abi = 0;  // kImageLibraryAbi of the module's build: a stale module is refused
@@ -33,16 +27,21 @@ struct ImageLibrary {
   // A PNG's colour as written, 8-bit sRGB, 3 bytes a pixel (rows from the top).
   void (*read_png)(const std::string& path, std::vector<uint8_t>& rgb, int& width,
                    int& height) = nullptr;
-  ColourComparison (*compare)(const Frame& a, const Frame& b, float fail, float warn) = nullptr;
+  // The number of pixels of two colour images (linear, frame.rgb) that Yee's perceptual metric
+  // tells apart (ImageBufAlgo::compare_Yee).
+  size_t (*perceptual)(const Frame& a, const Frame& b) = nullptr;
 };
 
 // Changes whenever ImageLibrary or a type it passes changes.
-constexpr int kImageLibraryAbi = 2;
+constexpr int kImageLibraryAbi = 3;
 
-// The module, loaded on first call from FLATMARCH_MODULE_DIR (environment), the build's module
-// folder, or ../lib beside the program; throws std::runtime_error saying where it looked and why
-// it could not load.
+// The module, loaded on first call from FLATMARCH_MODULE_DIR (environment: there alone, where it
+// is set), else the build's module folder or ../lib beside the program; throws
+// std::runtime_error saying where it looked and why it could not load.
 const ImageLibrary& image_library();
+// The same, or null where it cannot be loaded, with the reason in `why` (when given): for work
+// whose results are figures, which it goes on without (images left out, said once).
+const ImageLibrary* image_library_if_loadable(std::string* why = nullptr);
 
 }  // namespace flatmarch
 

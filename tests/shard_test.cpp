@@ -15,6 +15,7 @@
 #include "reports/shard.hpp"
 #include "scene/load.hpp"
 #include "tests/process.hpp"
+#include "tests/report_figures.hpp"
 
 namespace flatmarch {
 namespace {
@@ -22,6 +23,7 @@ namespace {
 using nlohmann::json;
 using reports::assign_shards;
 using reports::parse_shard;
+using test::deterministic_report;
 
 TEST(Shards, ParseIOfN) {
   ASSERT_TRUE(parse_shard("2/7"));
@@ -198,44 +200,6 @@ std::vector<Scene> small_gallery() {
   for (const char* s : {"torus", "l_shape", "mirror_pentagon", "cone_pi"})
     scenes.push_back(load_scene(std::string(FLATMARCH_SOURCE_DIR) + "/scenes/" + s + ".json"));
   return scenes;
-}
-
-// What a rerun measures alike: every field but the timings (and what is ranked by them).
-json deterministic_report(const json& results) {
-  json d;
-  for (json c : results["matrix"]["cases"]) {
-    c.erase("time_ms");
-    c.erase("time_samples_ms");
-    json counters;
-    for (const char* k : {"steps_mean", "steps_p99", "crossings_mean", "out_of_steps"})
-      counters[k] = c["counters"][k];
-    c["counters"] = counters;
-    d["matrix"].push_back(c);
-  }
-  d["skipped"] = results["matrix"]["skipped"];
-  for (json p : results["sweep"]["points"]) {
-    p.erase("time_ms");
-    d["points"].push_back(p);
-  }
-  d["confirmations"] = results["sweep"]["confirmations"];
-  for (json g : results["sweep"]["analysis"]) {
-    g.erase("pareto");
-    for (json& cell : g["grid"]) cell.erase("time_ms");
-    if (!g["recommended"].is_null()) g["recommended"].erase("time_ms");
-    d["analysis"].push_back(g);
-  }
-  for (json s : results["scaling"]["series"]) {
-    for (const char* k : {"time_ms", "slope", "lane_utilisation"}) s.erase(k);
-    d["scaling"].push_back(s);
-  }
-  for (const json& b : results["ranking"])
-    for (const char* k : {"cases", "passed", "limits", "errors"})
-      d["ranking"][b["backend"].get<std::string>()][k] = b[k];
-  // Which backend is recommended follows from speed where backends pass alike (the fastest
-  // one), and a run's speeds are not its shards': compared apart (expect_fastest_recommended).
-  d["recommendation"] = results["recommendation"];
-  for (const char* k : {"rays_per_s", "backend", "why"}) d["recommendation"].erase(k);
-  return d;
 }
 
 // The recommendation names the first backend of the ranking with a method that passed on every
