@@ -400,6 +400,67 @@ def ranking_section(results):
     return "\n".join(parts)
 
 
+def device_time_section(results, cases):
+    """Each GPU backend's frames split by the device's own clock: the march, the read-back, the rest."""
+    ranked = [b for b in results.get("ranking", []) if b.get("device_time")]
+    missing = sorted({c["backend"] for c in cases if c.get("device") and
+                      not c.get("counters", {}).get("device_ms")})
+    if not ranked and not missing:
+        return ""
+    parts = ["<h2 id=device>Time on the device</h2>",
+             "<p>A GPU backend's frame timed twice: by the clock around it (the wall time, what a user waits for "
+             "and what the ranking goes by) and by the device's own clock (OpenGL timer queries, Vulkan "
+             "timestamp queries), split into the march (the draws or dispatches), the read-back (the copy of "
+             "the frame to where the host reads it) and the rest (the wall time less the device's: submission, "
+             "waits, the host unpacking the frame). Timed frames read back their 8-bit colour alone. Geometric "
+             "means over the backend's timed cases; shares of the wall time are means. On a software "
+             "rasteriser the clock is the driver's: lavapipe's timestamps bracket its dispatch, llvmpipe's "
+             "OpenGL timer covers only part of its rasteriser threads' work.</p>"]
+    rows = []
+    for b in ranked:
+        d = b["device_time"]
+        shape = b.get("device", {}).get("kernel_shape", "")
+        rows.append([b["backend"], device_text(b), shape or "-", d["cases"], f'{d["wall_ms"]:.3g}',
+                     f'{d["device_ms"]:.3g}', pct(d["march_share"]), pct(d["readback_share"]),
+                     pct(d["rest_share"])])
+    if rows:
+        parts.append(table(["backend", "device", "kernel shape", "cases", "wall ms", "device ms", "march",
+                            "read-back", "rest"], rows))
+        fig, ax = plt.subplots(figsize=(7.0, 0.6 + 0.45 * len(ranked)))
+        names = [b["backend"] for b in ranked]
+        left = [0.0] * len(ranked)
+        for key, label, colour in (("march_share", "march", "#1f77b4"), ("readback_share", "read-back", "#ff7f0e"),
+                                   ("rest_share", "rest", "#bbbbbb")):
+            widths = [100 * b["device_time"][key] for b in ranked]
+            ax.barh(names, widths, left=left, color=colour, label=label)
+            left = [a + w for a, w in zip(left, widths)]
+        ax.set_xlabel("% of a frame's wall time")
+        ax.set_xlim(0, 100)
+        ax.invert_yaxis()
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+        parts.append(figure_html(fig, "each GPU backend's frame split by the device's clock"))
+    if missing:
+        parts.append("<p>No device time for " + ", ".join(esc(m) for m in missing) +
+                     ": its device has no clock (the benchmark's label says why).</p>")
+    return "\n".join(parts)
+
+
+def left_out_note(results):
+    """What a run measured without the image library left out, and how to draw it."""
+    left = results.get("left_out")
+    if not left:
+        return ""
+    drawn = left.get("drawn_by_merge")
+    what = ", ".join("Yee's perceptual check" if w == "image.perceptual_failpercent" else
+                     "each backend's frames and the recommended gallery" for w in left.get("what", []))
+    return (f'<p class="limit">Measured without the image library ({esc(left.get("why", "").splitlines()[0])}): '
+            f'left out, {esc(what)}; every other figure is measured, and the verdicts are the other checks\'.'
+            + (" The recommended gallery below was drawn afterwards by <code>flatmarch merge</code> on another "
+               "machine, with its backends." if drawn else
+               " <code>flatmarch merge results.json -o DIR/results.json</code> on a machine with OpenImageIO "
+               "draws the recommended gallery and this page.") + "</p>")
+
+
 def speed_accuracy_section(cases):
     types = [t for t in SURFACE_TYPES if any(c["surface_type"] == t for c in cases)]
     if not types:
@@ -959,6 +1020,7 @@ def one_machine(results, images, previous=None, previous_path=""):
     cases = results.get("matrix", {}).get("cases", [])
     sections = [("summary", "verdicts", summary_section(results, cases)),
                 ("ranking", "ranking", ranking_section(results)),
+                ("device", "device time", device_time_section(results, cases)),
                 ("recommended", "recommended choice", recommended_gallery_section(results, images)),
                 ("regression", "regression gate", regression_section(results)),
                 ("previous", "since the earlier run", previous_section(results, previous, previous_path)),
@@ -976,7 +1038,7 @@ def one_machine(results, images, previous=None, previous_path=""):
             f"{esc(results['options']['size'])} (median of {results['options']['repetitions']} repetitions, "
             f"Google Benchmark), conformance frames {esc(results['options']['conform_size'])}, eps "
             f"{results['options']['eps']:g}, offset {results['options']['offset']:g}.</p>",
-            shards_note(results),
+            shards_note(results), left_out_note(results),
             "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t, html_ in sections if html_) + "</nav>"]
     body += [html_ for _, _, html_ in sections if html_]
     return PAGE.format(title="flatmarch report", body="\n".join(body))

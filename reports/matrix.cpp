@@ -54,8 +54,13 @@ json accuracy_summary(const conformance::CaseResult& r) {
 }
 
 json device_json(const DeviceInfo& d) {
-  return {{"name", d.name},     {"type", d.type},         {"api", d.api},
-          {"driver", d.driver}, {"platform", d.platform}, {"software", d.software}};
+  return {{"name", d.name},
+          {"type", d.type},
+          {"api", d.api},
+          {"driver", d.driver},
+          {"platform", d.platform},
+          {"software", d.software},
+          {"kernel_shape", d.kernel_shape}};
 }
 
 std::string device_label(const DeviceInfo& d) {

@@ -54,7 +54,8 @@ using MatrixProgress = std::function<void(const std::string& line, int done, int
 // failed_checks (a line each) and failed (the names of the failed checks).
 nlohmann::json accuracy_summary(const conformance::CaseResult& r);
 
-// A GPU backend's device as results carry it: name, type, api, driver, platform, software.
+// A GPU backend's device as results carry it: name, type, api, driver, platform, software,
+// kernel_shape.
 nlohmann::json device_json(const DeviceInfo& device);
 // The same in one line, as benchmark runs are labelled: "device NAME; driver DRIVER; software".
 std::string device_label(const DeviceInfo& device);

@@ -139,6 +139,12 @@ json rank_backends(const json& matrix) {
     std::map<std::string, std::array<double, 4>> methods;  // cases, passed, log rays, timed
     // The SIMD backend's share of its peak (counter of_peak), per method: sum of logs, cases.
     std::map<std::string, std::array<double, 2>> of_peak;
+    // A GPU backend's frames on its device's clock (counters device_ms, march_ms, readback_ms):
+    // the cases timed so, the logs of their wall and device ms, and their shares of the wall
+    // time summed (march, read-back, the rest).
+    int device_timed = 0;
+    double log_wall = 0.0, log_device = 0.0;
+    std::array<double, 3> shares{};
   };
   std::map<std::string, Tally> tallies;
   std::map<std::string, json> devices;  // of the GPU backends
@@ -170,6 +176,15 @@ json rank_backends(const json& matrix) {
       ++t.timed;
       m[2] += l;
       m[3] += 1;
+      const double wall = c.value("time_ms", 0.0), device = c["counters"].value("device_ms", 0.0);
+      if (wall > 0.0 && device > 0.0) {
+        ++t.device_timed;
+        t.log_wall += std::log(wall);
+        t.log_device += std::log(device);
+        t.shares[0] += c["counters"].value("march_ms", 0.0) / wall;
+        t.shares[1] += c["counters"].value("readback_ms", 0.0) / wall;
+        t.shares[2] += std::max(0.0, wall - device) / wall;
+      }
       if (const double p = c["counters"].value("of_peak", 0.0); p > 0.0) {
         auto& share = t.of_peak[c["method"].get<std::string>()];
         share[0] += std::log(p);
@@ -207,6 +222,16 @@ json rank_backends(const json& matrix) {
     if (devices.count(b)) {
       ranking.back()["device"] = devices[b];
       ranking.back()["software"] = devices[b].value("software", false);
+    }
+    // Beside the wall time it is ranked by, what the device itself took (GPU backends).
+    if (t.device_timed > 0) {
+      const double n = t.device_timed;
+      ranking.back()["device_time"] = {{"cases", t.device_timed},
+                                       {"wall_ms", std::exp(t.log_wall / n)},
+                                       {"device_ms", std::exp(t.log_device / n)},
+                                       {"march_share", t.shares[0] / n},
+                                       {"readback_share", t.shares[1] / n},
+                                       {"rest_share", t.shares[2] / n}};
     }
   }
   std::stable_sort(ranking.begin(), ranking.end(), [](const json& a, const json& b) {
@@ -335,6 +360,17 @@ std::string describe_selection(const json& results, const std::string& type) {
       s += "  on " + b["device"]["name"].get<std::string>() +
            (b["device"]["software"].get<bool>() ? " (software: a rasteriser on the CPU)" : "") +
            ", " + b["device"].value("driver", std::string("?"));
+    if (b.contains("device_time")) {
+      const json& d = b["device_time"];
+      std::snprintf(line, sizeof line,
+                    "; a frame %.3g ms, %.3g ms of it on the device (march %.0f%%, read-back "
+                    "%.0f%%, the rest %.0f%%)",
+                    d["wall_ms"].get<double>(), d["device_ms"].get<double>(),
+                    100.0 * d["march_share"].get<double>(),
+                    100.0 * d["readback_share"].get<double>(),
+                    100.0 * d["rest_share"].get<double>());
+      s += line;
+    }
     s += "\n";
   }
   return s;

@@ -5,6 +5,8 @@
 // visibly, with its reason.
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <algorithm>
 #include <memory>
 #include <ostream>
@@ -137,6 +139,22 @@ TEST_P(BackendContract, ARepeatedFrameIsTheSame) {
   const Frame a = backend_->render(scene, scene.camera, 48, 27, {}, {});
   const Frame b = backend_->render(scene, scene.camera, 48, 27, {}, {});
   EXPECT_TRUE(a.hit == b.hit && a.steps == b.steps && a.t == b.t && a.rgb == b.rgb);
+}
+
+// A frame for the eye or the clock has at least the colour: 8-bit sRGB (a GPU backend's, read
+// back alone) or the whole frame; and a backend that runs on a device says how its clock timed
+// the frame, where one that runs on none says nothing.
+TEST_P(BackendContract, AFrameOfTheColourHasEveryPixelsColour) {
+  const Scene& scene = test::gallery_scene("l_shape");
+  const Frame f = backend_->render_colour(scene, scene.camera, 48, 27, {}, {});
+  EXPECT_EQ(f.width, 48);
+  EXPECT_EQ(f.height, 27);
+  EXPECT_TRUE(f.srgb.size() == 4u * 48 * 27 || f.rgb.size() == 3u * 48 * 27);
+  const std::optional<DeviceTiming> t = backend_->last_device_timing();
+  if (backend_->device() && backend_->name() != "webgl")
+    EXPECT_TRUE(t.has_value()) << "a GPU backend says how its device timed the frame";
+  if (!backend_->device()) EXPECT_FALSE(t.has_value());
+  if (t && !t->measured) EXPECT_FALSE(t->why.empty()) << "an unmeasured frame says why";
 }
 
 TEST_P(BackendContract, ThreadsDoNotChangeTheFrame) {

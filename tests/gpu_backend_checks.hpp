@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 #include <vector>
 
 #include "backends/bands.hpp"
@@ -58,6 +60,39 @@ inline void expect_band_views_as_scalar(const Backend& backend) {
           << name << " from z = " << camera.position.z << ": " << differ << " pixels differ";
       EXPECT_GT(entered, want.hit.size() / 8) << name << ": the view must see the rooms";
     }
+  }
+}
+
+// A frame of the colour alone (Backend::render_colour) holds the whole frame's colour as a PNG
+// holds it: tone-mapped linear colour sRGB-encoded in 8 bits (within a unit: the shader encodes
+// in float32), alpha 255, and nothing else; and both kinds of frame are timed on the device.
+inline void expect_colour_frames_as_whole_frames(const Backend& backend) {
+  const Scene& scene = gallery_scene("cube");
+  MarchParams params;
+  params.method = Method::analytic;
+  const Frame whole = backend.render(scene, scene.camera, 64, 36, params, {});
+  const std::optional<DeviceTiming> whole_time = backend.last_device_timing();
+  const Frame colour = backend.render_colour(scene, scene.camera, 64, 36, params, {});
+  const std::optional<DeviceTiming> colour_time = backend.last_device_timing();
+  ASSERT_EQ(colour.srgb.size(), 4 * whole.hit.size());
+  EXPECT_TRUE(colour.rgb.empty());
+  EXPECT_FALSE(colour.has_aovs());
+  size_t off = 0;
+  for (size_t px = 0; px < whole.hit.size(); ++px) {
+    for (size_t k = 0; k < 3; ++k) {
+      const double c = std::clamp(static_cast<double>(whole.rgb[3 * px + k]), 0.0, 1.0);
+      const double encoded = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+      off += std::abs(colour.srgb[4 * px + k] - 255.0 * encoded) > 1.0;
+    }
+    off += colour.srgb[4 * px + 3] != 255;
+  }
+  EXPECT_EQ(off, 0u) << "channels more than a unit from the whole frame's colour";
+  for (const auto& t : {whole_time, colour_time}) {
+    ASSERT_TRUE(t.has_value()) << "a GPU backend says how its device timed the frame";
+    ASSERT_TRUE(t->measured) << t->why;  // llvmpipe and lavapipe have the queries
+    EXPECT_GT(t->seconds(), 0.0);
+    EXPECT_GE(t->march_s, 0.0);
+    EXPECT_GE(t->readback_s, 0.0);
   }
 }
 

@@ -33,6 +33,14 @@ TEST(OpenGl, ReportsProgressInBandsToTheEnd) {
   test::expect_progress_in_bands(opengl());
 }
 
+TEST(OpenGl, AFrameOfTheColourAloneIsTheWholeFramesColourInEitherShape) {
+  SKIP_WITHOUT_OPENGL();
+  test::expect_colour_frames_as_whole_frames(opengl());
+  const OpenGlBackend other(BackendOptions{
+      .kernel_shape = opengl().device()->kernel_shape == "gpu" ? "software" : "gpu"});
+  test::expect_colour_frames_as_whole_frames(other);
+}
+
 TEST(OpenGl, CamerasWithinAndOutsideTheBandSeeAsTheScalarKernel) {
   SKIP_WITHOUT_OPENGL();
   test::expect_band_views_as_scalar(opengl());

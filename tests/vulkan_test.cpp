@@ -98,6 +98,16 @@ TEST(VulkanShader, GlslangErrorsNameTheBrokenLine) {
   }
 }
 
+TEST(Vulkan, AFrameOfTheColourAloneIsTheWholeFramesColourInEitherShapeAndReadBack) {
+  SKIP_WITHOUT_VULKAN();
+  test::expect_colour_frames_as_whole_frames(vulkan());
+  const VulkanBackend other(
+      BackendOptions{.kernel_shape = vulkan().device()->kernel_shape == "gpu" ? "software" : "gpu",
+                     .vk_staging = true,
+                     .validation = true});
+  test::expect_colour_frames_as_whole_frames(other);
+}
+
 TEST(Vulkan, CamerasWithinAndOutsideTheBandSeeAsTheScalarKernel) {
   SKIP_WITHOUT_VULKAN();
   test::expect_band_views_as_scalar(vulkan());

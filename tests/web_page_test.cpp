@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/webgl/chromium.hpp"
+#include "backends/webgl/webgl.hpp"
 #include "cli/common.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
@@ -177,6 +178,30 @@ TEST_F(WebPage, MShowsAndHidesTheFloorPlan) {
 }
 
 // No Chromium: the webgl backend is unavailable, and a command that needs it exits 3 saying why.
+// The page's two kernel shapes (?shape=, --kernel-shape of the webgl backend) march the same rays
+// to the same ends in the same steps; unforced, a page on SwiftShader picks the software shape.
+TEST(WebGlShapes, TheGpuShapeMarchesAsTheSoftwareShape) {
+  const WebGlBackend picked, software(BackendOptions{.kernel_shape = "software"}),
+      gpu(BackendOptions{.kernel_shape = "gpu"});
+  if (const Availability a = software.availability(); !a.available)
+    GTEST_SKIP() << "the webgl backend is unavailable here: " << a.reason;
+  EXPECT_EQ(software.device()->kernel_shape, "software");
+  EXPECT_EQ(gpu.device()->kernel_shape, "gpu");
+  EXPECT_EQ(picked.device()->kernel_shape, picked.device()->software ? "software" : "gpu");
+  const Scene& scene = test::gallery_scene("cube");
+  for (Method m : {Method::sphere, Method::analytic}) {
+    MarchParams params;
+    params.method = m;
+    const Frame a = software.render(scene, scene.camera, 48, 27, params, {});
+    const Frame b = gpu.render(scene, scene.camera, 48, 27, params, {});
+    for (size_t px = 0; px < a.hit.size(); ++px) {
+      ASSERT_EQ(a.hit[px], b.hit[px]) << to_string(m) << " pixel " << px;
+      ASSERT_EQ(a.steps[px], b.steps[px]) << to_string(m) << " pixel " << px;
+      ASSERT_EQ(a.crossings[px], b.crossings[px]) << to_string(m) << " pixel " << px;
+    }
+  }
+}
+
 TEST(WebGlCli, WithoutChromiumExits3AndSaysWhy) {
   const std::string out = test::make_temp_dir() + "/x.png";
   const std::string scene = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";

@@ -55,16 +55,34 @@ function withParams(source, e, o) {
                         (all, head) => head + glslFloat(e) + ", " + glslFloat(o) + ",");
 }
 
+// The kernel's shape (kernels/march_params.hpp, KernelShape): ?shape=software or gpu, else by the
+// renderer WebGL names. A software rasteriser (Chromium's SwiftShader, Mesa's llvmpipe) runs
+// every branch for every lane, and gets the kernel shaped for that; a GPU gets the gpu shape.
+function softwareRenderer() {
+  const debug = gl && gl.getExtension("WEBGL_debug_renderer_info");
+  const name = gl ? String(gl.getParameter(debug ? debug.UNMASKED_RENDERER_WEBGL : gl.RENDERER)) : "";
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+const shape = query.get("shape") || (softwareRenderer() ? "software" : "gpu");
+if (shape !== "software" && shape !== "gpu") fail("?shape= wants software or gpu, got " + shape);
+window.flatmarchShape = shape;
+// Our own shaders in the page's shape: the gpu shape's define after the version line.
+const shaped = (source) =>
+  shape === "gpu" ? source.replace(/^(#version[^\n]*\n)/, "$1#define FLATMARCH_GPU_SHAPE\n") : source;
+
 const programs = {};
 // A method's program (its shader in scene.shaders, with the eps and offset of the keys), or
-// `source` under `name`.
-function program(name, source) {
+// `source` under `name`: the page's own in its shape, or `foreign` (the original app's) as it is.
+function program(name, source, foreign = false) {
   if (!source && (epsSteps || offsetSteps)) {
     const key = name + "@" + epsSteps + "," + offsetSteps;
-    if (!programs[key]) programs[key] = link(withParams(scene.shaders[name], eps(), offset()));
+    if (!programs[key]) programs[key] = link(shaped(withParams(scene.shaders[name], eps(), offset())));
     return programs[key];
   }
-  if (!programs[name]) programs[name] = link(source || scene.shaders[name]);
+  if (!programs[name]) {
+    const fragment = source || scene.shaders[name];
+    programs[name] = link(foreign ? fragment : shaped(fragment));
+  }
   return programs[name];
 }
 function link(fragment) {
@@ -147,7 +165,7 @@ window.flatmarchTimeFrames = ({ method: m = method, camera: c = camera, fragment
   document.body.classList.add("frame");
   let prog, set;
   if (fragment) {
-    prog = program("fragment:" + fragment, fragment);
+    prog = program("fragment:" + fragment, fragment, true);
     const setters = [gl.uniform1fv, gl.uniform2fv, gl.uniform3fv, gl.uniform4fv];
     set = () => {
       for (const [name, v] of Object.entries(uniforms || {}))

@@ -113,6 +113,8 @@ struct WebGlBackend::Session {
     if (!folder.empty()) fs::remove_all(folder, ignored);
   }
 
+  std::string shape;  // ?shape= of the pages (BackendOptions::kernel_shape), "" for the page's own
+
   // Opens the page of `scene` and `params` in read-back mode, unless it is open.
   void open(const Scene& scene, const MarchParams& params) {
     web::PageOptions options;
@@ -123,7 +125,9 @@ struct WebGlBackend::Session {
     page.clear();
     const fs::path file = folder / ("page-" + std::to_string(++pages) + ".html");
     std::ofstream(file, std::ios::binary) << text;
-    browser->navigate("file://" + file.string() + "?readback", kStartTimeout);
+    browser->navigate(
+        "file://" + file.string() + "?readback" + (shape.empty() ? "" : "&shape=" + shape),
+        kStartTimeout);
     if (!browser->evaluate("typeof flatmarchReadback === 'object'").get<bool>())
       throw std::runtime_error(
           "the webgl backend's page did not start: " +
@@ -167,6 +171,14 @@ WebGlBackend::Session* WebGlBackend::session() const {
                        ") cannot draw to float targets (EXT_color_buffer_float)";
         return;
       }
+      if (!parse_kernel_shape(options_.kernel_shape, false)) {
+        unavailable_ =
+            "--kernel-shape: expected auto, software or gpu, got \"" + options_.kernel_shape + "\"";
+        return;
+      }
+      // Forced, the pages take the shape; else each picks it by its renderer, as on the web.
+      if (options_.kernel_shape == "software" || options_.kernel_shape == "gpu")
+        s->shape = options_.kernel_shape;
       session_ = std::move(s);
     } catch (const std::exception& e) {
       unavailable_ = e.what();
