@@ -14,7 +14,10 @@
 //
 // llvmpipe and lavapipe use as many threads as there are cores unless LP_NUM_THREADS says
 // otherwise. --device=D picks the device of both backends (an index or a part of its name, as
-// `flatmarch backends` lists them); every run is labelled with its device.
+// `flatmarch backends` lists them), --kernel-shape=software|gpu their kernel's shape (default:
+// by the device); every run is labelled with its device and shape. Timed frames are frames of the
+// colour alone (Backend::render_colour), each also timed on the device: counters device_ms,
+// march_ms, readback_ms and rest_ms (reports::DeviceTimes).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -47,9 +50,10 @@ void frame(benchmark::State& state, const Backend* backend, const Scene* scene, 
            MarchParams params, Size size, std::string view) {
   std::string label;
   if (const std::optional<DeviceInfo> d = backend->device()) label = reports::device_label(*d);
-  // The first frame compiles the scene's program; it is not timed, and the counters are its.
-  // The timed ones are frames of the colour alone, as a user waits for them.
+  // The first frames compile the scene's programs; they are not timed, and the counters are the
+  // whole frame's. The timed ones are frames of the colour alone, as a user waits for them.
   const Frame whole = backend->render(*scene, camera, size.width, size.height, params, {});
+  backend->render_colour(*scene, camera, size.width, size.height, params, {});
   reports::DeviceTimes device;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
@@ -93,8 +97,16 @@ int main(int argc, char** argv) {
   BackendOptions options;
   std::string peer_shaders =
       std::getenv("FLATMARCH_PEER_SHADERS") ? std::getenv("FLATMARCH_PEER_SHADERS") : "";
-  const auto flags = bench::take_flags(argc, argv, {"device", "peer-shaders"});
+  const auto flags = bench::take_flags(argc, argv, {"device", "peer-shaders", "kernel-shape"});
   if (flags.count("device")) options.device = flags.at("device");
+  if (flags.count("kernel-shape")) {
+    options.kernel_shape = flags.at("kernel-shape");
+    if (!parse_kernel_shape(options.kernel_shape, false)) {
+      std::cerr << "gpu_bench: --kernel-shape=auto, software or gpu, not " << options.kernel_shape
+                << "\n";
+      return 2;
+    }
+  }
   if (flags.count("peer-shaders")) peer_shaders = flags.at("peer-shaders");
   if (!bench::begin(argc, argv)) return 2;
   const OpenGlBackend opengl(options);

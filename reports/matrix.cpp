@@ -150,9 +150,14 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
           [&backend, &scene, camera, params, width, height, last, simd, whole, simd_figures,
            peak_seconds, label](benchmark::State& state) {
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
-            DeviceTimes device;
+            DeviceTimes device_times;
             try {
-              if (!*whole) *whole = backend.render(scene, camera, width, height, params, {});
+              // The first frames compile the programs (a GPU backend's whole frame and its
+              // frame of the colour alone are two): untimed.
+              if (!*whole) {
+                *whole = backend.render(scene, camera, width, height, params, {});
+                backend.render_colour(scene, camera, width, height, params, {});
+              }
               for (auto _ : state) {
                 const auto start = std::chrono::steady_clock::now();
                 const Frame f = backend.render_colour(scene, camera, width, height, params, {});
@@ -164,7 +169,7 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
                         .count());
                 state.SetIterationTime(seconds);
-                device.add(backend, seconds);
+                device_times.add(backend, seconds);
               }
               if (simd && !simd_figures->known) {
                 simd->render_counted(scene, camera, width, height, params, {}, simd_figures->lanes);
@@ -178,10 +183,10 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
               return;
             }
             const std::string clock =
-                device.why().empty() ? "" : "no device clock: " + device.why();
+                device_times.why().empty() ? "" : "no device clock: " + device_times.why();
             state.SetLabel(label.empty() || clock.empty() ? label + clock : label + "; " + clock);
             frame_counters(state, **whole);
-            device.counters(state);
+            device_times.counters(state);
             if (last) *last = **whole;
           })
           ->Unit(benchmark::kMillisecond)

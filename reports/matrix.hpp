@@ -72,17 +72,17 @@ nlohmann::json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions&
 // registrations after.
 nlohmann::json run_registered_benchmarks(const std::function<void(const std::string&)>& on_run);
 
-// Registers one timed case, BACKEND/METHOD/SCENE/WxH: frames of the scene's camera, after one
-// untimed whole frame (GPU backends compile the scene's program then; the deterministic counters
-// are its), each timed frame one of its colour alone (Backend::render_colour: what a user waits
-// for; the GPU backends read back nothing else) timed by the backend's own measure where it has
-// one (Backend::last_frame_seconds: webgl's page), else by the clock around it (Google
-// Benchmark's manual time); counters rays_per_s, steps_mean, steps_p99, crossings_mean,
-// out_of_steps, a GPU backend's device times (DeviceTimes) and, for the SIMD backend,
-// lane_utilisation, steps_per_s, peak_steps_per_s and of_peak (simd_counters); a GPU backend's
-// runs are labelled with its device (device_label). `last`, when given, receives the whole frame.
-// Repetitions and min_time of 0 leave them to Google Benchmark's flags (--benchmark_repetitions,
-// --benchmark_min_time).
+// Registers one timed case, BACKEND/METHOD/SCENE/WxH: frames of the scene's camera, after an
+// untimed whole frame and an untimed frame of its colour (a GPU backend compiles a program for
+// each then; the deterministic counters are the whole frame's), each timed frame one of its colour
+// alone (Backend::render_colour: what a user waits for; the GPU backends read back nothing else)
+// timed by the backend's own measure where it has one (Backend::last_frame_seconds: webgl's page),
+// else by the clock around it (Google Benchmark's manual time); counters rays_per_s, steps_mean,
+// steps_p99, crossings_mean, out_of_steps, a GPU backend's device times (DeviceTimes) and, for the
+// SIMD backend, lane_utilisation, steps_per_s, peak_steps_per_s and of_peak (simd_counters); a GPU
+// backend's runs are labelled with its device (device_label). `last`, when given, receives the
+// whole frame. Repetitions and min_time of 0 leave them to Google Benchmark's flags
+// (--benchmark_repetitions, --benchmark_min_time).
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
                               const MarchParams& params, int width, int height, int repetitions,
                               double min_time, Frame* last = nullptr, const std::string& name = "");
