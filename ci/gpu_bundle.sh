@@ -37,7 +37,8 @@ grep -m1 '^CMAKE_HOME_DIRECTORY:INTERNAL=' "$build/CMakeCache.txt" | cut -d= -f2
 tar -C "$stage" -cJf "$dest/bundle.tar.xz" .
 # The loaders the backends open at run time, and the validation layer the Vulkan tests run under.
 lists=$(mktemp -d)
-opts=(-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 "-oDir::State::Lists=$lists")
+opts=(-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 "-oDir::State::Lists=$lists"
+  -oAPT::Sandbox::User=root)
 mkdir -p "$lists/partial"
 apt-get "${opts[@]}" update -qq
 (cd "$dest/debs" && apt-get "${opts[@]}" download -qq libvulkan1 libegl1 libglvnd0 libopengl0 \

@@ -319,6 +319,7 @@ std::string image_module_missing() {
 void say_left_out(const std::string& command, const std::string& what, const std::string& how) {
   std::string why = image_module_missing();
   for (size_t at; (at = why.find("\n  ")) != std::string::npos;) why.replace(at, 3, " ");
+  std::fflush(stdout);  // after what the command printed, not amid it
   std::fprintf(stderr, "%s: left out, %s: no image library here (%s). %s\n", command.c_str(),
                what.c_str(), why.c_str(), how.c_str());
 }
