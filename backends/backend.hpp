@@ -114,7 +114,6 @@ struct Frame {
     f.srgb.resize(4 * static_cast<size_t>(w) * static_cast<size_t>(h));
     return f;
   }
-  bool has_aovs() const { return !hit.empty(); }
   // Every pixel must then be written (set). Inline: the image module (output/image_library.hpp)
   // makes frames without linking the backends.
   Frame(int w, int h)
@@ -229,7 +228,7 @@ class Backend {
   virtual Frame render(const Scene& scene, const Camera& camera, int width, int height,
                        const MarchParams& params, const Progress& progress) const = 0;
   // A frame for the eye or the clock: at least its colour. The GPU backends read back the 8-bit
-  // sRGB colour alone (Frame::srgb, a ninth of render()'s read-back); the others give render()'s
+  // sRGB colour alone (Frame::srgb, an eighth of render()'s read-back); the others give render()'s
   // frame. Timed runs draw these; whatever compares frames draws render()'s.
   virtual Frame render_colour(const Scene& scene, const Camera& camera, int width, int height,
                               const MarchParams& params, const Progress& progress) const {

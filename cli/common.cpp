@@ -143,9 +143,8 @@ void add_backend_options(CLI::App& app, BackendOptions& options) {
 
 void check_backend_options(const BackendOptions& options) {
   if (options.threads < 0) throw UsageError("--threads: must be 0 (all cores) or more");
-  if (!parse_kernel_shape(options.kernel_shape, false))
-    throw UsageError("--kernel-shape: expected auto, software or gpu, got \"" +
-                     options.kernel_shape + "\"");
+  if (const std::string e = kernel_shape_error(options.kernel_shape); !e.empty())
+    throw UsageError(e);
   const std::vector<std::string> isas = simd::isa_names(false);
   if (!options.isa.empty() && std::find(isas.begin(), isas.end(), options.isa) == isas.end()) {
     throw UsageError("--isa: unknown instruction set \"" + options.isa + "\" (" + joined(isas) +

@@ -107,8 +107,8 @@ void warn_about_resolution(const Scene& scene, const MarchParams& params);
 // Why the image module (OpenImageIO) cannot be loaded here, or "" where it can: the commands whose
 // results are figures then measure without it, and say once what they left out.
 std::string image_module_missing();
-// The one line they say it in, on stderr: "COMMAND: left out, WHAT: no image library here (WHY's
-// first line). HOW".
+// The one line they say it in, on stderr: "COMMAND: left out, WHAT: no image library here (WHY).
+// HOW".
 void say_left_out(const std::string& command, const std::string& what, const std::string& how);
 // The note on Yee's metric, which the conformance checks leave out without the module.
 extern const char* const kPerceptualLeftOut;

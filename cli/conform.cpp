@@ -227,7 +227,8 @@ void add_conform(CLI::App& app) {
         }
     }
     if (!no_images.empty())
-      out["unmeasured"] = {{"check", "image.perceptual_failpercent"}, {"why", no_images}};
+      out["unmeasured"] =
+          nlohmann::json::array({{{"check", "image.perceptual_failpercent"}, {"why", no_images}}});
     std::ofstream(o->json) << out.dump(1) << "\n";
     std::printf("%d cases: %d pass, %d at their method's limit, %d failed; wrote %s\n", cases,
                 cases - failed - limits, limits, failed, o->json.c_str());

@@ -20,9 +20,8 @@ void add_shader(CLI::App& app) {
       "fragment shader (--kernel-shape software) or compute shader (gpu), or the vulkan backend's\n"
       "compute shader (--backend vulkan), the kernel specialised on the features the scene uses,\n"
       "with its tables baked in as constants. The march parameters are baked in too (a change of\n"
-      "method or eps is a new program). --compile compiles it (or a file of yours with --file) "
-      "and\n"
-      "shows any error with the lines around it.");
+      "method or eps is a new program). --compile compiles it (or a file of yours with --file)\n"
+      "and shows any error with the lines around it.");
   struct Options {
     std::string scene, file, out, backend = "opengl", shape = "software";
     bool trace = false, compile = false;

@@ -43,4 +43,10 @@ std::optional<KernelShape> parse_kernel_shape(const std::string& text, bool soft
   return std::nullopt;
 }
 
+std::string kernel_shape_error(const std::string& text) {
+  return parse_kernel_shape(text, false)
+             ? ""
+             : "--kernel-shape: expected auto, software or gpu, got \"" + text + "\"";
+}
+
 }  // namespace flatmarch

@@ -35,6 +35,8 @@ const char* to_string(KernelShape s);
 // "auto" (or empty): the software shape on a software device, else the gpu shape; "software",
 // "gpu": that shape. Nothing for any other text.
 std::optional<KernelShape> parse_kernel_shape(const std::string& text, bool software_device);
+// What is wrong with --kernel-shape `text`, or "" when parse_kernel_shape takes it.
+std::string kernel_shape_error(const std::string& text);
 
 struct MarchParams {
   Method method = Method::sphere;

@@ -414,8 +414,9 @@ def device_time_section(results, cases):
              "the frame to where the host reads it) and the rest (the wall time less the device's: submission, "
              "waits, the host unpacking the frame). Timed frames read back their 8-bit colour alone. Geometric "
              "means over the backend's timed cases; shares of the wall time are means. On a software "
-             "rasteriser the clock is the driver's: lavapipe's timestamps bracket its dispatch, llvmpipe's "
-             "OpenGL timer covers only part of its rasteriser threads' work.</p>"]
+             "rasteriser the clock is the driver's: lavapipe's timestamps bracket its dispatch, llvmpipe "
+             "answers OpenGL's queries when its setup thread passes them, not when its rasteriser threads have "
+             "drawn, so its split says nothing of the work.</p>"]
     rows = []
     for b in ranked:
         d = b["device_time"]

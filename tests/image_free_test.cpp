@@ -214,6 +214,10 @@ TEST(WithoutTheImageModule, ConformMeasuresAndSaysWhatItLeftOut) {
     x["checks"] = checks;
     EXPECT_EQ(x, y) << a["cases"][k]["scene"] << " " << a["cases"][k]["method"];
   }
+  ASSERT_EQ(b["unmeasured"].size(), 1u);
+  EXPECT_EQ(b["unmeasured"][0]["check"], "image.perceptual_failpercent");
+  EXPECT_FALSE(a.contains("unmeasured"));
+  EXPECT_FALSE(std::filesystem::is_empty(dir / "errors")) << "the normal run draws them";
   EXPECT_NE(bare.err.find("conform: left out, Yee's perceptual check and the error images"),
             std::string::npos)
       << bare.err;

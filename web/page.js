@@ -65,7 +65,6 @@ function softwareRenderer() {
 }
 const shape = query.get("shape") || (softwareRenderer() ? "software" : "gpu");
 if (shape !== "software" && shape !== "gpu") fail("?shape= wants software or gpu, got " + shape);
-window.flatmarchShape = shape;
 // Our own shaders in the page's shape: the gpu shape's define after the version line.
 const shaped = (source) =>
   shape === "gpu" ? source.replace(/^(#version[^\n]*\n)/, "$1#define FLATMARCH_GPU_SHAPE\n") : source;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <initializer_list>
 
 #include "backends/bands.hpp"
 
@@ -32,6 +33,22 @@ GLuint compile(const Api& gl, GLenum stage, const std::string& source) {
                             kernel::annotate_log(source, log));
 }
 
+// Links compiled shaders (deleted here: freed with the program) into a program.
+GLuint link(const Api& gl, std::initializer_list<GLuint> shaders) {
+  const GLuint program = gl.CreateProgram();
+  for (GLuint shader : shaders) gl.AttachShader(program, shader);
+  gl.LinkProgram(program);
+  for (GLuint shader : shaders) gl.DeleteShader(shader);
+  GLint ok = GL_FALSE, length = 0;
+  gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (ok == GL_TRUE) return program;
+  gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+  std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
+  gl.GetProgramInfoLog(program, length, nullptr, log.data());
+  gl.DeleteProgram(program);
+  throw kernel::ShaderError("the shader program does not link:\n" + log);
+}
+
 }  // namespace
 
 GLuint link_program(const Api& gl, const std::string& vertex, const std::string& fragment) {
@@ -43,36 +60,11 @@ GLuint link_program(const Api& gl, const std::string& vertex, const std::string&
     gl.DeleteShader(vs);
     throw;
   }
-  const GLuint program = gl.CreateProgram();
-  gl.AttachShader(program, vs);
-  gl.AttachShader(program, fs);
-  gl.LinkProgram(program);
-  gl.DeleteShader(vs);  // freed with the program
-  gl.DeleteShader(fs);
-  GLint ok = GL_FALSE, length = 0;
-  gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (ok == GL_TRUE) return program;
-  gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-  std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
-  gl.GetProgramInfoLog(program, length, nullptr, log.data());
-  gl.DeleteProgram(program);
-  throw kernel::ShaderError("the shader program does not link:\n" + log);
+  return link(gl, {vs, fs});
 }
 
 GLuint link_compute(const Api& gl, const std::string& compute) {
-  const GLuint cs = compile(gl, GL_COMPUTE_SHADER, compute);
-  const GLuint program = gl.CreateProgram();
-  gl.AttachShader(program, cs);
-  gl.LinkProgram(program);
-  gl.DeleteShader(cs);
-  GLint ok = GL_FALSE, length = 0;
-  gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (ok == GL_TRUE) return program;
-  gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-  std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
-  gl.GetProgramInfoLog(program, length, nullptr, log.data());
-  gl.DeleteProgram(program);
-  throw kernel::ShaderError("the compute program does not link:\n" + log);
+  return link(gl, {compile(gl, GL_COMPUTE_SHADER, compute)});
 }
 
 namespace {

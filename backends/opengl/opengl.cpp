@@ -86,9 +86,7 @@ void OpenGlBackend::make_context() const {
     c->gl_context = gl::make_context(options_.device);
     const std::optional<KernelShape> shape =
         parse_kernel_shape(options_.kernel_shape, c->gl_context->device().software);
-    if (!shape)
-      throw std::invalid_argument("--kernel-shape: expected auto, software or gpu, got \"" +
-                                  options_.kernel_shape + "\"");
+    if (!shape) throw std::invalid_argument(kernel_shape_error(options_.kernel_shape));
     c->shape = *shape;
     const gl::Context::Current current(*c->gl_context);
     const gl::Api& gl = c->gl();

@@ -488,8 +488,7 @@ void VulkanBackend::make_context() const {
     c->software = c->physical.getProperties().deviceType == vk::PhysicalDeviceType::eCpu;
     const std::optional<KernelShape> shape = parse_kernel_shape(options_.kernel_shape, c->software);
     if (!shape) {
-      unavailable_ =
-          "--kernel-shape: expected auto, software or gpu, got \"" + options_.kernel_shape + "\"";
+      unavailable_ = kernel_shape_error(options_.kernel_shape);
       return;
     }
     c->shape = *shape;

@@ -171,9 +171,8 @@ WebGlBackend::Session* WebGlBackend::session() const {
                        ") cannot draw to float targets (EXT_color_buffer_float)";
         return;
       }
-      if (!parse_kernel_shape(options_.kernel_shape, false)) {
-        unavailable_ =
-            "--kernel-shape: expected auto, software or gpu, got \"" + options_.kernel_shape + "\"";
+      if (const std::string e = kernel_shape_error(options_.kernel_shape); !e.empty()) {
+        unavailable_ = e;
         return;
       }
       // Forced, the pages take the shape; else each picks it by its renderer, as on the web.
