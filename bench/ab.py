@@ -10,6 +10,7 @@ interleaved rounds" figures are measured; machines here are noisy, so only ratio
 mean anything.
 
     python3 bench/ab.py BASE NEW --filter='simd/analytic/(cube|l_shape)/avx512/' --rounds 3 --pin 0
+    python3 bench/ab.py P P --new-env FLATMARCH_SIMD_TUNE=avx2.refill_at=5 --filter=...  # one knob
 
 --pin runs both on one CPU (taskset), the steadiest figures on a shared machine; simd_bench then
 registers its cases on one thread. bench/build_at.sh builds BASE from an earlier revision.
@@ -44,6 +45,12 @@ def parse_args(argv):
                         help="--benchmark_min_time in seconds for each case (0.3)")
     parser.add_argument("--pin", type=int, metavar="CPU",
                         help="run both on this one CPU (taskset -c CPU)")
+    parser.add_argument("--base-env", action="append", default=[], metavar="NAME=VALUE",
+                        help="an environment variable for BASE's runs alone (repeatable); with "
+                        "BASE and NEW one program, two settings of it: e.g. a tuning probe build "
+                        "and FLATMARCH_SIMD_TUNE (backends/simd/tuning.hpp)")
+    parser.add_argument("--new-env", action="append", default=[], metavar="NAME=VALUE",
+                        help="the same for NEW's runs")
     parser.add_argument("--timeout", type=float, default=1800,
                         help="seconds one program run may take before it is stopped (1800)")
     args = parser.parse_args(argv)
@@ -51,6 +58,14 @@ def parse_args(argv):
         parser.error(f"--rounds must be 1 to 100, not {args.rounds}")
     if args.min_time <= 0:
         parser.error(f"--min-time must be positive, not {args.min_time}")
+    for flag in ("base_env", "new_env"):
+        pairs = {}
+        for item in getattr(args, flag):
+            name, eq, value = item.partition("=")
+            if not eq or not name:
+                parser.error(f"--{flag.replace('_', '-')} {item}: expected NAME=VALUE")
+            pairs[name] = value
+        setattr(args, flag, pairs)
     for path in (args.base, args.new):
         if not (os.path.isfile(path) and os.access(path, os.X_OK)):
             parser.error(f"{path}: not an executable file")
@@ -63,14 +78,16 @@ def parse_args(argv):
     return args
 
 
-def run_once(program, args):
-    """{case name: run} of one run of `program`, or raises RuntimeError saying why not."""
+def run_once(program, args, env=None):
+    """{case name: run} of one run of `program` (with `env` added to the environment), or raises
+    RuntimeError saying why not."""
     command = [program, f"--benchmark_filter={args.filter}",
                f"--benchmark_min_time={args.min_time}", "--benchmark_format=json"]
     if args.pin is not None:
         command = ["taskset", "-c", str(args.pin)] + command
     try:
-        done = subprocess.run(command, capture_output=True, text=True, timeout=args.timeout)
+        done = subprocess.run(command, capture_output=True, text=True, timeout=args.timeout,
+                              env={**os.environ, **(env or {})})
     except subprocess.TimeoutExpired:
         raise RuntimeError(f"{program}: still running after {args.timeout:.0f} s (--timeout)")
     if done.returncode != 0:
@@ -112,7 +129,7 @@ def main(argv):
         for side in sides:
             print(f"round {r + 1}/{args.rounds}: {side}", file=sys.stderr, flush=True)
             try:
-                cases = run_once(getattr(args, side), args)
+                cases = run_once(getattr(args, side), args, getattr(args, side + "_env"))
             except RuntimeError as e:
                 print(f"ab.py: {e}", file=sys.stderr)
                 return 1

@@ -37,6 +37,7 @@
 #include <array>
 
 #include "backends/simd/packet.hpp"
+#include "backends/simd/tuning.hpp"
 
 HWY_BEFORE_NAMESPACE();
 namespace flatmarch::simd {
@@ -102,8 +103,15 @@ HWY_INLINE VI Rank(M m) {
   return hn::BitCast(di, hn::PopulationCount(hn::And(bits, below)));
 }
 
-// Entry `index` of `table` for each lane, the table held in `vectors` vectors, one or two: in
-// two, a lookup in each and the lane's own kept.
+// This target's row of tuning.hpp's table.
+constexpr Isa kIsa = HWY_TARGET <= HWY_AVX3   ? Isa::avx512
+                     : HWY_TARGET == HWY_AVX2 ? Isa::avx2
+                                              : Isa::sse4;
+// The most vectors LookUp takes (Tuning::most_vectors is held to it).
+constexpr size_t kLookUpVectors = 4;
+
+// Entry `index` of `table` for each lane, the table held in `vectors` vectors (1 to
+// kLookUpVectors): in several, a lookup in each (or in each pair) and the lane's own kept.
 template <class DT, typename T>
 FLATMARCH_PACKET_INLINE hn::Vec<DT> LookUp(DT d, const T* table, size_t vectors, VI index) {
   if (vectors == 1) return hn::TableLookupLanes(hn::LoadU(d, table), hn::IndicesFromVec(d, index));
@@ -113,17 +121,25 @@ FLATMARCH_PACKET_INLINE hn::Vec<DT> LookUp(DT d, const T* table, size_t vectors,
   // TwoTablesLookupLanes): the cube's analytic frames 0.93-0.94x the time of two lookups and
   // a blend (5 interleaved rounds), the double pentagon's 0.95-0.99x.
   if constexpr (sizeof(T) == 4 && hn::MaxLanes(d) == 16) {
-    const auto low = hn::LoadU(d, table), high = hn::LoadU(d, table + lanes);
-    if constexpr (hwy::IsFloat<T>())
-      return hn::Vec<DT>{_mm512_permutex2var_ps(low.raw, index.raw, high.raw)};
-    else
-      return hn::Vec<DT>{_mm512_permutex2var_epi32(low.raw, index.raw, high.raw)};
+    const auto pair = [&](const T* at) FLATMARCH_PACKET_LAMBDA {
+      const auto low = hn::LoadU(d, at), high = hn::LoadU(d, at + lanes);
+      if constexpr (hwy::IsFloat<T>())
+        return hn::Vec<DT>{_mm512_permutex2var_ps(low.raw, index.raw, high.raw)};
+      else
+        return hn::Vec<DT>{_mm512_permutex2var_epi32(low.raw, index.raw, high.raw)};
+    };
+    if (vectors == 2) return pair(table);
+    const auto upper = hn::RebindMask(d, hn::Gt(index, SplatI(2 * lanes - 1)));
+    return hn::IfThenElse(upper, pair(table + 2 * lanes), pair(table));
   }
 #endif
   const auto low = hn::IndicesFromVec(d, hn::And(index, SplatI(lanes - 1)));
-  const auto upper = hn::RebindMask(d, hn::Gt(index, SplatI(lanes - 1)));
-  return hn::IfThenElse(upper, hn::TableLookupLanes(hn::LoadU(d, table + lanes), low),
-                        hn::TableLookupLanes(hn::LoadU(d, table), low));
+  auto v = hn::TableLookupLanes(hn::LoadU(d, table), low);
+  for (size_t k = 1; k < vectors && k < kLookUpVectors; ++k) {
+    const auto beyond = hn::RebindMask(d, hn::Gt(index, SplatI(static_cast<int>(k) * lanes - 1)));
+    v = hn::IfThenElse(beyond, hn::TableLookupLanes(hn::LoadU(d, table + k * lanes), low), v);
+  }
+  return v;
 }
 
 // What a packet of rays is doing (march.glsl's Ray, one lane per ray).

@@ -48,7 +48,8 @@ class Marcher : private RayEvents {
         whole_(job.tables->polygons.size() > 1 && solids_.by_lane() &&
                walls_.whole(params_.method == kMethodAnalytic)),
         one_room_(job.tables->polygons.size() == 1),
-        nearest_(whole_ && walls_.glue_by_lane() && !walls_.same_rooms()) {}
+        nearest_(whole_ && walls_.glue_by_lane() && !walls_.same_rooms()),
+        rooms_per_pass_(std::clamp(tuning(kIsa).rooms_per_pass, 1, kRoomsPerPass)) {}
 
   // Edges held by no lane.
   static void clear(HeldEdges& held) {
@@ -136,7 +137,7 @@ class Marcher : private RayEvents {
           sphere_step<false>(r, x, pending, rooms, nullptr);
         pending = None();
         // Counted as two rooms whatever their number: a whole pass costs the same over any
-        // number, so the packet need not wait to refill its rays together (kRefillSpread).
+        // number, so the packet need not wait to refill its rays together (Tuning::refill_spread).
         rooms_seen = 2;
       }
     }
@@ -144,7 +145,7 @@ class Marcher : private RayEvents {
       Rooms rooms;
       M pass = None();
       rooms.first_edge = rooms.edge_count = SplatI(0);
-      const int most_rooms = walls_.merge() ? kRoomsPerPass : 1;
+      const int most_rooms = walls_.merge() ? rooms_per_pass_ : 1;
       if (one_room_) {  // the scene's one room: no search
         rooms.count = 1;
         rooms.lanes[0] = pass = pending;
@@ -371,8 +372,9 @@ class Marcher : private RayEvents {
   // in scenes of several rooms and few solids whose edges the lanes can hold or look up
   // (Walls::whole).
   bool whole_;
-  bool one_room_;  // the scene has one room: a step's pass needs no search for rooms
-  bool nearest_;   // whole passes look their edges up by lane (ExitByNearestLine applies)
+  bool one_room_;       // the scene has one room: a step's pass needs no search for rooms
+  bool nearest_;        // whole passes look their edges up by lane (ExitByNearestLine applies)
+  int rooms_per_pass_;  // Tuning::rooms_per_pass
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)

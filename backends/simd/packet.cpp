@@ -99,40 +99,9 @@ HWY_INLINE void CameraRays(const PacketJob& job, VI i, VI j, V& dx, V& dy, V& dz
   dz = d.z.v;
 }
 
-// Lanes wait for a new pixel until this many eighths of them do: refilling costs a shading and a
-// camera ray for the whole packet, and waiting lanes idle. Measured on 8 lanes, 640x360, 2 cores,
-// one run (ms at 2/8 -> 4/8): the analytic method's short rays refill often and gain (cube
-// 24.9 -> 20.4, double pentagon 13.8 -> 11.4, L-shape 8.9 -> 8.4); so does sphere tracing in the
-// cube (228 -> 183: rays refilled together start together in the camera's room, and stay in
-// fewer rooms a packet), while on the L-shape and the torus it is level (86.7 -> 87.8, 52.1 ->
-// 52.1; a recheck in three interleaved rounds: the L-shape up to 5% slower, within this machine's
-// noise); 5/8 loses 18% on the L-shape's sphere tracing, 1/8 spends more on refills than it gains.
-constexpr size_t kRefillAt = 4;
-// For the analytic method, while the packet's rays are spread over rooms (its last step passed
-// over more than two), lanes wait until six eighths of them can take a pixel: refilled rays start
-// together in the camera's room, and the packet stays in fewer rooms. Against 4/8 everywhere,
-// 640x360, 2 cores, AVX-512, best of 2 rounds: 32- and 128-square staircases 27.0 -> 24.2 and
-// 27.5 -> 24.6 ms, every gallery scene within 4% either way. Sphere tracing keeps 4/8: with
-// 6/8 it gained on the 32-square staircase only a few percent (compared across runs) with fewer
-// lanes busy (0.96 -> 0.82), and with the rule at more than one room it lost 5-8% on the
-// 4-square staircase and the double pentagon (one run).
-constexpr size_t kRefillSpread = 6;
-// In a scene of one or two rooms without mirrors (for the analytic method, one room with or
-// without), once this many steps have passed since the last refill, the lanes waiting are
-// refilled however few they are: there rays refilled apart stay in few rooms, and long rays
-// (prisms: hundreds of steps) no longer leave lanes idle for long. Sphere and relaxed tracing in
-// two rooms wait longer (kRefillPatienceTwoRooms): at 16 steps they were 3-8% slower on the
-// double pentagon, its singularities and the pillowcase. 640x360, 2 cores, AVX-512, best of 2
-// interleaved rounds against no patience: prisms 0.89-0.96x the time, lanes busy 0.78-0.86 ->
-// 0.86-0.99; the two-room scenes' analytic method 0.90-0.97x; the rest 0.96-1.04x. In scenes of
-// more rooms it made sphere tracing on the cube 1.2x and on a 32-square staircase 1.8x slower
-// (rays started apart spread over more rooms a pass, and a pass over one room is the cheapest),
-// and sphere tracing in the mirror rooms 1.10-1.15x slower (rays started apart meet different
-// mirrors at a step, and a reflection takes a round per mirror); the analytic method there is
-// level with it (0.99-1.02x) and keeps a few more lanes busy (the 30-60-90 triangle 0.84 ->
-// 0.85).
-constexpr int kRefillPatience = 16;
-constexpr int kRefillPatienceTwoRooms = 48;
+// The refill rule's thresholds (tuning.hpp's Tuning::refill_at, refill_spread, patience and
+// patience_two_rooms, per instruction set, with how each was measured) are read in
+// MarchPacketsWith.
 
 // The pixels of the blocks of tiles a thread takes from `blocks`, in the order its packet takes
 // them: block after block as they come, tile by tile within a block, row-major; lane order within
@@ -227,9 +196,9 @@ class PixelQueue {
 
 // Marches the pixels of the blocks of tiles it takes from `blocks`, until none is left, and
 // writes them. The lanes of one packet take the pixels tile by tile, and a lane whose ray has
-// ended takes a next pixel soon (kRefillAt), so that a few long rays do not hold up the rest of
-// their tile; one block's pixels follow the last's in the same packet, so lanes stay busy until
-// the frame's pixels run out. kNearest: Marcher::step's.
+// ended takes a next pixel soon (Tuning::refill_at), so that a few long rays do not hold up the
+// rest of their tile; one block's pixels follow the last's in the same packet, so lanes stay busy
+// until the frame's pixels run out. kNearest: Marcher::step's.
 template <bool kNearest>
 HWY_NOINLINE void MarchPacketsWith(const PacketJob& job, TileBlocks& blocks, int part,
                                    LaneCounts* lanes) {
@@ -257,20 +226,26 @@ HWY_NOINLINE void MarchPacketsWith(const PacketJob& job, TileBlocks& blocks, int
   const int64_t bound = pixels * (int64_t{job.tables->params.max_steps} + 1) + 1;
   M occupied = None();  // lanes holding a pixel
   const bool analytic = kNearest || job.tables->params.method == kMethodAnalytic;
-  bool spread = false;  // the analytic method's rays over several rooms (kRefillSpread)
+  // Lanes wait for a new pixel until refill_at eighths of them do (refill_spread while the
+  // analytic method's rays are spread over several rooms); in a scene of one room (two without
+  // mirrors) no longer than `patience` steps (Tuning).
+  const Tuning tune = tuning(kIsa);
+  bool spread = false;  // the analytic method's rays over several rooms (Tuning::refill_spread)
   const size_t rooms_in_scene = job.tables->polygons.size();
   const bool mirrors = (job.tables->features & kFeatureMirrors) != 0u;
-  int patience = 0;  // none: refill by kRefillAt and kRefillSpread only
-  if ((analytic || !mirrors) && rooms_in_scene == 1) patience = kRefillPatience;
+  int patience = 0;  // none: refill by refill_at and refill_spread only
+  if ((analytic || !mirrors) && rooms_in_scene == 1) patience = tune.patience;
   if (!mirrors && rooms_in_scene == 2)
-    patience = analytic ? kRefillPatience : kRefillPatienceTwoRooms;
+    patience = analytic ? tune.patience : tune.patience_two_rooms;
+  const size_t refill_at = static_cast<size_t>(tune.refill_at) * n / 8;
+  const size_t refill_spread = static_cast<size_t>(tune.refill_spread) * n / 8;
   int waited = 0;  // steps since the last refill, counted where patience applies
   for (int64_t iteration = 0; iteration < bound; ++iteration) {
     // Lanes are refilled once enough of them wait, or when none is left marching.
     const M waiting = queue.more() ? r.done : hn::And(r.done, occupied);
     const size_t count = hn::CountTrue(D(), waiting);
-    if (count > 0 && (count >= (spread ? kRefillSpread : kRefillAt) * n / 8 ||
-                      hn::AllTrue(D(), r.done) || (patience > 0 && waited >= patience))) {
+    if (count > 0 && (count >= (spread ? refill_spread : refill_at) || hn::AllTrue(D(), r.done) ||
+                      (patience > 0 && waited >= patience))) {
       waited = 0;
       // Write out the rays that have ended, then give their lanes the next pixels.
       V cr, cg, cb;
@@ -324,18 +299,27 @@ HWY_NOINLINE void MarchPacketsWith(const PacketJob& job, TileBlocks& blocks, int
 // the analytic method alone. Inlined into the one loop, the nearest line gave back what it saved
 // (double pentagon 0.94x, cube 0.98x) on the frames that never take it (4-square staircase
 // 1.04-1.09x, L-shape 1.02-1.04x: the code around the step compiled differently, NOTES.md); in a
-// copy of its own those are compiled as before. AVX-512 only: there the cube's edges and the
-// double pentagon's fit in two vectors (AVX2's hold the double pentagon's alone), and a copy for
+// copy of its own those are compiled as before. The copy is compiled only for the instruction
+// sets whose tuning takes it (Tuning::nearest_line; every one in a probe build): a copy for
 // every instruction set made this file's compile 196 -> 256 s (-O2 -g, one core; AVX-512's
 // alone, 216 s).
-void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
-#if HWY_TARGET <= HWY_AVX3
-  if (job.exit_by_nearest_line) {
-    MarchPacketsWith<true>(job, blocks, part, lanes);
-    return;
-  }
+#ifdef FLATMARCH_SIMD_TUNING_PROBE
+constexpr bool kNearestLineCompiled = true;
+#else
+constexpr bool kNearestLineCompiled = tuning(kIsa).nearest_line;
 #endif
+template <bool kCompiled>
+void MarchPacketsChosen(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
+  if constexpr (kCompiled) {
+    if (job.exit_by_nearest_line && tuning(kIsa).nearest_line) {
+      MarchPacketsWith<true>(job, blocks, part, lanes);
+      return;
+    }
+  }
   MarchPacketsWith<false>(job, blocks, part, lanes);
+}
+void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
+  MarchPacketsChosen<kNearestLineCompiled>(job, blocks, part, lanes);
 }
 
 // The rays of the frame's central tile (a packet's worth, clamped to the frame), started from the

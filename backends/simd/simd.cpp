@@ -60,6 +60,12 @@ std::vector<std::string> isa_names(bool supported_only) {
   return names;
 }
 
+int64_t isa_target(const std::string& name) {
+  for (const auto& [isa, target] : kIsas)
+    if (name == isa) return target;
+  return 0;
+}
+
 }  // namespace simd
 
 SimdBackend::SimdBackend(BackendOptions options) : options_(std::move(options)) {
@@ -108,6 +114,10 @@ Availability SimdBackend::availability() const {
 simd::PacketCode SimdBackend::code() const {
   if (target_ == 0) throw std::runtime_error("the simd backend is unavailable: " + unavailable_);
   return code_;
+}
+
+int SimdBackend::threads() const {
+  return options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
 }
 
 int SimdBackend::lanes() const {

@@ -18,6 +18,8 @@ namespace simd {
 // Instruction sets by the names --isa takes, best first: those compiled in and, when
 // `supported_only`, those this CPU runs.
 std::vector<std::string> isa_names(bool supported_only);
+// The Highway target of --isa's `name` (packet_code's argument); 0 for a name it does not know.
+int64_t isa_target(const std::string& name);
 // The threads a backend's frames run on (a oneTBB arena; simd.cpp).
 struct Threads;
 }  // namespace simd
@@ -52,6 +54,8 @@ class SimdBackend final : public Backend {
   // The instruction set it runs (--isa's name) and its lanes per packet; "" and 0 if unavailable.
   std::string isa() const { return isa_; }
   int lanes() const;
+  // The threads its frames run on: options.threads, or all cores for 0.
+  int threads() const;
 
  private:
   simd::PacketCode code() const;

@@ -43,13 +43,17 @@ class Walls {
         features_(job.tables->features),
         convex_(!job.tables->edges.empty() && job.tables->edges[0].link.w != 0) {
     // Passes over several rooms read each lane's edge from the scene's edge numbers: by a lookup
-    // in up to kMostVectors vectors when the edges fit in them, else by a broadcast per room
-    // blended by lane (cheaper than a gather), for scenes of up to kMostEdges edges.
+    // in up to Tuning::most_vectors vectors when the edges fit in them, else by a broadcast per
+    // room blended by lane (cheaper than a gather), for scenes of up to kMostEdges edges.
     const kernel::SceneTables<float>& tables = *job.tables;
     const EdgeTables& t = job.edges;
     const size_t edges = tables.edges.size(), lanes = hn::Lanes(D());
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
-    mode_ = vectors_ <= kMostVectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
+    const Tuning tune = tuning(kIsa);
+    const size_t most_vectors = static_cast<size_t>(std::clamp(
+        tables.params.method == kMethodAnalytic ? tune.most_vectors_analytic : tune.most_vectors, 1,
+        static_cast<int>(kLookUpVectors)));
+    mode_ = vectors_ <= most_vectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
     if (mode_ != kTable && t.glue_by_slot && static_cast<size_t>(t.most_edges) <= lanes &&
         t.tints.size() <= 2 * lanes)
       by_slot_.take(t);
@@ -461,8 +465,6 @@ class Walls {
   enum Mode { kSingle, kTable, kBlend } mode_ = kSingle;
   bool held_ = false;  // held()
   int most_edges_ = 0;
-  // kTable's vectors a table, one or two (in three, slower than kBlend: NOTES.md).
-  static constexpr size_t kMostVectors = 2;
   // Where number f of edge k is alike in every room, bit k of alike_[f], and the number.
   std::array<uint32_t, kFields> alike_{};
   std::array<std::array<float, kAlikeSlots>, kFields> alike_number_{};
