@@ -3,12 +3,13 @@
 // method, on all cores with the best instruction set here, and on staircases of 4, 32 and 128
 // squares (reports/surfaces.hpp; rays run to max_distance 40), where rays spread over many rooms,
 // and of 32 and 128 squares drawn apart (staircase_apart_N: rooms that differ in coordinates).
-// For the L-shape and the double pentagon it also runs, side by side in one run, the scalar
-// backend, the SIMD backend on one thread, and every instruction set on one thread; for the cube
-// and the 32-square staircase the scalar backend: bench/speedups.py turns the JSON into the ratios
-// (SIMD on all cores over scalar, all cores over one thread). The staircases' analytic method
-// also runs every instruction set on one thread: whether time per ray stays flat from 4 to 128
-// squares depends on the vector width (crossings by slot need the tints in one or two vectors).
+// For the L-shape, the double pentagon, the cube and the 32-square staircase it also runs, side by
+// side in one run, the scalar backend and every instruction set on one thread and on all cores:
+// bench/speedups.py turns the JSON into the ratios (SIMD over scalar on one thread per lane, the
+// lane efficiency; all cores over scalar; all cores over one thread). The staircases' analytic
+// method also runs every instruction set on one thread: whether time per ray stays flat from 4 to
+// 128 squares depends on the vector width (crossings by slot need the tints in one or two
+// vectors).
 //
 //   simd_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //              --benchmark_out=simd.json --benchmark_out_format=json   (one line)
@@ -19,7 +20,9 @@
 
 #include <oneapi/tbb/info.h>
 
+#include <algorithm>
 #include <iostream>
+#include <iterator>
 #include <string>
 
 #include "backends/scalar/scalar.hpp"
@@ -31,6 +34,9 @@ namespace flatmarch {
 namespace {
 
 constexpr int kWidth = 640, kHeight = 360;
+// The scenes timed beside the scalar backend, on one thread and on all cores in every instruction
+// set: issue 73's lane efficiency (bench/speedups.py) is taken on these.
+constexpr const char* kCompared[] = {"l_shape", "double_pentagon", "cube", "staircase_32"};
 
 void simd_frame(benchmark::State& state, const Scene* scene, MarchParams params,
                 BackendOptions options) {
@@ -101,8 +107,9 @@ int main(int argc, char** argv) {
   };
   for (Method method : kKernelMethods) {
     for (const auto& scene : scenes) {
-      const bool compared = scene->name == "l_shape" || scene->name == "double_pentagon";
-      if (compared || scene->name == "cube" || scene->name == "staircase_32") {
+      const bool compared =
+          std::find(std::begin(kCompared), std::end(kCompared), scene->name) != std::end(kCompared);
+      if (compared) {
         bench::add((std::string("scalar/") + to_string(method) + "/" + scene->name).c_str(),
                    scalar_frame, scene.get(), case_params(*scene, method))
             ->Unit(benchmark::kMillisecond)
@@ -111,7 +118,12 @@ int main(int argc, char** argv) {
       const bool staircase = scene->name.rfind("staircase_", 0) == 0;
       if (compared || (staircase && method == Method::analytic))
         for (const std::string& isa : isas) simd_case(scene.get(), method, isa, 1);
-      if (!compared || cores > 1) simd_case(scene.get(), method, isas.front(), cores);
+      // The compared scenes on all cores in every instruction set (how each scales); the rest
+      // in the best.
+      if (compared && cores > 1)
+        for (const std::string& isa : isas) simd_case(scene.get(), method, isa, cores);
+      else if (!compared)
+        simd_case(scene.get(), method, isas.front(), cores);
     }
   }
   return bench::run();

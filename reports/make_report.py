@@ -382,6 +382,9 @@ def ranking_section(results):
         for m in methods:
             mm = b["methods"].get(m)
             peak = f', {pct(mm["of_peak"])} of peak' if mm and "of_peak" in mm else ""
+            if mm and "lane_efficiency" in mm:
+                peak += f', {pct(mm["lane_efficiency"])} of its lanes'
+
             row.append(f'{mrays(mm["rays_per_s"])} ({int(mm["passed"])}/{int(mm["cases"])} pass{peak})'
                        if mm else "-")
         row.append(b["best_method"] or "-")
@@ -389,7 +392,9 @@ def ranking_section(results):
     parts.append("<p>Backends ranked: those that passed every conformance case first, then by the geometric "
                  "mean of rays per second over every scene and method; a case at its method's limit is no pass. "
                  "Per method: Mrays/s (cases passed; for the "
-                 "SIMD backend, the geometric mean of how much of this CPU's peak its frames reach, see Steps). "
+                 "SIMD backend, the geometric means of how much of this CPU's peak its frames reach and of its lane "
+                 "efficiency: what one thread of it does over what the scalar backend's thread does, over its "
+                 "lanes, see Steps). "
                  "A GPU backend names the device it ran on; <i>software</i> marks a rasteriser running on the "
                  "CPU (Mesa's llvmpipe and lavapipe, Chromium's SwiftShader), whose speed says nothing of a GPU's.</p>")
     parts.append(table(["rank", "backend", "device", "Mrays/s", "verdicts"] + [f"{m} Mrays/s" for m in methods] +
@@ -721,22 +726,37 @@ def steps_heatmap_section(cases):
     ax.set_title("Kernel steps per ray")
     simd = {(c["scene"], c["method"]): c["counters"] for c in cases
             if "lane_utilisation" in c.get("counters", {})}
+    scalar = {(c["scene"], c["method"]): c["counters"].get("rays_per_s", 0) for c in cases
+              if c.get("backend") == "scalar" and "counters" in c}
     lane_table = ""
     if simd:
         methods = [m for m in METHODS if any(k[1] == m for k in simd)]
 
-        def cell(counters):
+        def efficiency(key, counters):
+            """lane_efficiency of reports/report.hpp, or None."""
+            one = counters.get("one_thread_rays_per_s", counters.get("rays_per_s", 0))
+            lanes, base = counters.get("lanes", 0), scalar.get(key, 0)
+            return one / base / lanes if lanes and base and one else None
+
+        def cell(key):
+            counters = simd[key]
             text = pct(counters["lane_utilisation"]) + " lanes"
             if "of_peak" in counters:
                 text += f' · {pct(counters["of_peak"])} of peak'
+            e = efficiency(key, counters)
+            if e is not None:
+                text += f' · {pct(e)} of {int(counters["lanes"])} lanes'
             return text
         lane_table = ("<p>SIMD lane utilisation: the share of packet lanes doing work, over every step of every "
                       "packet (rays of a packet that finish early, or step apart, leave lanes idle); and how close "
                       "to what this CPU can do the frame runs: its kernel steps a second over the peak, the steps a "
                       "second of one room's step on full packets on every core (no lane idle, nothing to shade or "
-                      "write, the tables in cache).</p>" +
+                      "write, the tables in cache); and its lane efficiency: one thread's rays a second over the "
+                      "scalar backend's (one thread too), over the lanes of the instruction set it ran, so "
+                      "<i>x% of 16 lanes</i> is x% of what these lanes could do if each ran the scalar backend's "
+                      "ray as fast (where the run has the scalar backend's case too).</p>" +
                       table(["scene"] + methods,
-                            [[s] + [cell(simd[(s, m)]) if (s, m) in simd else "-" for m in methods] for s in scenes]))
+                            [[s] + [cell((s, m)) if (s, m) in simd else "-" for m in methods] for s in scenes]))
     return ("<h2 id=steps>Steps per ray</h2><p>The mean number of kernel iterations per ray of the timed frames, per "
             "scene, backend and method: the cost the backends share; backends of one method should agree.</p>"
             + figure_html(fig, "steps heatmap") + lane_table)

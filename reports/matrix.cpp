@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <numeric>
 #include <regex>
@@ -119,6 +120,29 @@ class CollectingReporter : public benchmark::JSONReporter {
   std::function<void(const std::string&)> on_run_;
 };
 
+// The SIMD backend's rays a second on one thread, its instruction set the same: the median of
+// three frames of the colour after one untimed (the lane efficiency's numerator, against the
+// scalar backend's one thread). 0 where the backend runs one thread already (its timed frames
+// are that figure) or cannot run.
+double one_thread_rays_per_s(const SimdBackend& simd, const Scene& scene, const Camera& camera,
+                             int width, int height, const MarchParams& params) {
+  if (simd.threads() == 1 || simd.isa().empty()) return 0.0;
+  BackendOptions options;
+  options.isa = simd.isa();
+  options.threads = 1;
+  const SimdBackend one(options);
+  one.render_colour(scene, camera, width, height, params, {});
+  std::array<double, 3> seconds{};
+  for (double& s : seconds) {
+    const auto start = std::chrono::steady_clock::now();
+    const Frame f = one.render_colour(scene, camera, width, height, params, {});
+    benchmark::DoNotOptimize(f.rgb.data());
+    s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  std::sort(seconds.begin(), seconds.end());
+  return seconds[1] > 0.0 ? static_cast<double>(width) * height / seconds[1] : 0.0;
+}
+
 }  // namespace
 
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
@@ -140,6 +164,7 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
     bool known = false;
     simd::LaneCounts lanes;
     double peak = 0.0;
+    double one_thread_rays_per_s = 0.0;  // 0: not measured (the backend runs one thread)
   };
   auto simd_figures = std::make_shared<SimdFigures>();
   benchmark::internal::Benchmark* b =
@@ -175,9 +200,16 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                 simd->render_counted(scene, camera, width, height, params, {}, simd_figures->lanes);
                 simd_figures->peak =
                     simd->peak_lane_steps(scene, camera, width, height, params, peak_seconds);
+                simd_figures->one_thread_rays_per_s =
+                    one_thread_rays_per_s(*simd, scene, camera, width, height, params);
                 simd_figures->known = true;
               }
-              if (simd) simd_counters(state, **whole, simd_figures->lanes, simd_figures->peak);
+              if (simd) {
+                simd_counters(state, **whole, simd_figures->lanes, simd_figures->peak);
+                state.counters["lanes"] = simd->lanes();
+                if (simd_figures->one_thread_rays_per_s > 0.0)
+                  state.counters["one_thread_rays_per_s"] = simd_figures->one_thread_rays_per_s;
+              }
             } catch (const std::exception& e) {
               state.SkipWithError(e.what());
               return;

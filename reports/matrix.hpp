@@ -79,8 +79,10 @@ nlohmann::json run_registered_benchmarks(const std::function<void(const std::str
 // timed by the backend's own measure where it has one (Backend::last_frame_seconds: webgl's page),
 // else by the clock around it (Google Benchmark's manual time); counters rays_per_s, steps_mean,
 // steps_p99, crossings_mean, out_of_steps, a GPU backend's device times (DeviceTimes) and, for the
-// SIMD backend, lane_utilisation, steps_per_s, peak_steps_per_s and of_peak (simd_counters); a GPU
-// backend's runs are labelled with its device (device_label). `last`, when given, receives the
+// SIMD backend, lane_utilisation, steps_per_s, peak_steps_per_s and of_peak (simd_counters), lanes,
+// and one_thread_rays_per_s (the median of three frames on one thread of its instruction set,
+// where it runs more: the numerator of its lane efficiency, report.hpp); a GPU backend's runs are
+// labelled with its device (device_label). `last`, when given, receives the
 // whole frame. Repetitions and min_time of 0 leave them to Google Benchmark's flags
 // (--benchmark_repetitions, --benchmark_min_time).
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,

@@ -131,6 +131,13 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
   return results;
 }
 
+double lane_efficiency(const json& counters, double scalar_rays_per_s) {
+  const double lanes = counters.value("lanes", 0.0);
+  const double one = counters.value("one_thread_rays_per_s", counters.value("rays_per_s", 0.0));
+  if (lanes <= 0.0 || scalar_rays_per_s <= 0.0 || one <= 0.0) return 0.0;
+  return one / scalar_rays_per_s / lanes;
+}
+
 json rank_backends(const json& matrix) {
   struct Tally {
     int cases = 0, passed = 0, limits = 0, errors = 0;
@@ -139,6 +146,8 @@ json rank_backends(const json& matrix) {
     std::map<std::string, std::array<double, 4>> methods;  // cases, passed, log rays, timed
     // The SIMD backend's share of its peak (counter of_peak), per method: sum of logs, cases.
     std::map<std::string, std::array<double, 2>> of_peak;
+    // And its lane efficiency (lane_efficiency()), per method: sum of logs, cases.
+    std::map<std::string, std::array<double, 2>> efficiency;
     // A GPU backend's frames on its device's clock (counters device_ms, march_ms, readback_ms):
     // the cases timed so, the logs of their wall and device ms, and their shares of the wall
     // time summed (march, read-back, the rest).
@@ -148,6 +157,15 @@ json rank_backends(const json& matrix) {
   };
   std::map<std::string, Tally> tallies;
   std::map<std::string, json> devices;  // of the GPU backends
+  // The scalar backend's rays a second by scene, method and size: what a lane efficiency is of.
+  std::map<std::string, double> scalar;
+  const auto key = [](const json& c) {
+    return c.value("scene", "") + "/" + c.value("method", "") + "/" +
+           std::to_string(c.value("width", 0)) + "x" + std::to_string(c.value("height", 0));
+  };
+  for (const json& c : matrix.value("cases", json::array()))
+    if (c.value("backend", "") == "scalar" && !c.contains("error") && c.contains("counters"))
+      scalar[key(c)] = c["counters"].value("rays_per_s", 0.0);
   std::vector<std::string> order;
   for (const json& c : matrix.value("cases", json::array())) {
     const std::string b = c["backend"];
@@ -190,6 +208,13 @@ json rank_backends(const json& matrix) {
         share[0] += std::log(p);
         share[1] += 1;
       }
+      const auto s = scalar.find(key(c));
+      if (const double e = lane_efficiency(c["counters"], s == scalar.end() ? 0.0 : s->second);
+          e > 0.0) {
+        auto& share = t.efficiency[c["method"].get<std::string>()];
+        share[0] += std::log(e);
+        share[1] += 1;
+      }
     }
   }
   json ranking = json::array();
@@ -205,6 +230,10 @@ json rank_backends(const json& matrix) {
           {"cases", m[0]}, {"passed", m[1]}, {"rays_per_s", rays}, {"conforms", conforms}};
       if (const auto share = t.of_peak.find(name); share != t.of_peak.end())
         methods[name]["of_peak"] = std::exp(share->second[0] / share->second[1]);
+      if (const auto share = t.efficiency.find(name); share != t.efficiency.end()) {
+        methods[name]["lane_efficiency"] = std::exp(share->second[0] / share->second[1]);
+        methods[name]["lane_efficiency_cases"] = share->second[1];
+      }
       if (conforms && rays > best_rays) {
         best = name;
         best_rays = rays;

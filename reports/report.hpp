@@ -58,6 +58,12 @@ nlohmann::json merge_report(const std::vector<std::pair<std::string, nlohmann::j
 // group by the geometric mean of rays per second over its cases; per backend its pass rate,
 // speed, and fastest conforming method.
 nlohmann::json rank_backends(const nlohmann::json& matrix);
+// A SIMD case's lane efficiency (issue 73): its rays a second on one thread (counter
+// one_thread_rays_per_s, or rays_per_s where its frames ran on one) over the scalar backend's
+// `scalar_rays_per_s` on the same scene, method and size, over its lanes (counter lanes): the
+// share of what these lanes could do if each ran the scalar backend's ray as fast. 0 where a
+// figure is missing. rank_backends gives each method's geometric mean (lane_efficiency).
+double lane_efficiency(const nlohmann::json& counters, double scalar_rays_per_s);
 
 // The choice for this machine: the top backend and its method, with eps and offset per surface
 // type from the sweep (DESIGN.md's defaults where the sweep has no stable point).

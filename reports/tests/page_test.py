@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The report's page as a browser sees it: a small real report run (two scenes, the scalar
 backend, a tiny sweep) checked against the committed baseline fixture data/page_baseline.json
-(made to regress one figure and improve another) and compared with the earlier run
+(made to regress one figure and improve another), the SIMD backend beside the scalar one and compared with the earlier run
 data/page_previous.json (one case failed there, one passed that is now at its method's limit),
 loaded in headless Chromium. Checks that the verdicts are counted apart, each non-pass case shows
 every failed check, the regression section shows the gate's verdict and the regressed figure,
@@ -66,7 +66,7 @@ def main():
     os.makedirs(out)
     run = subprocess.run(
         [flatmarch, "report", "--scene", os.path.join(SCENES, "torus.json"),
-         "--scene", os.path.join(SCENES, "l_shape_prism.json"), "--backend", "scalar",
+         "--scene", os.path.join(SCENES, "l_shape_prism.json"), "--backend", "scalar", "--backend", "simd",
          "--method", "sphere", "--method", "analytic", "--size", "48x27", "--conform-size", "48x27",
          "--repetitions", "2", "--min-time", "0.001", "--sweep-size", "16x9", "--no-scaling", "-q",
          "-o", os.path.join(out, "run"), "--baseline", os.path.join(HERE, "data", "page_baseline.json"),
@@ -135,6 +135,23 @@ def main():
         expect(section(dom, anchor), f"no {anchor} section")
     for failure in ("stuck", "wrong_edge", "missed_object", "phantom_hit", "early_escape", "late_escape", "leak"):
         expect(f"<td>{failure}</td>" in section(dom, "definitions"), f"definitions: no failure class {failure}")
+
+    # The SIMD backend's lane efficiency (issue 73): one thread over the scalar backend, over its
+    # lanes, per case in the steps section and per method in the ranking, as results.json has it.
+    simd = [c for c in cases if c["backend"] == "simd" and "counters" in c]
+    scalar_rays = {(c["scene"], c["method"]): c["counters"]["rays_per_s"] for c in cases
+                   if c["backend"] == "scalar" and "counters" in c}
+    expect(simd, "no timed simd case in the run")
+    steps = section(dom, "steps")
+    for c in simd:
+        k = c["counters"]
+        one = k.get("one_thread_rays_per_s", k["rays_per_s"])
+        want = f'{100 * one / scalar_rays[(c["scene"], c["method"])] / k["lanes"]:.3g}% of {int(k["lanes"])} lanes'
+        expect(want in steps, f"steps: {c['name']} should show {want!r}")
+    ranked = next((b for b in results["ranking"] if b["backend"] == "simd"), {})
+    expect(all("lane_efficiency" in m for m in ranked.get("methods", {}).values()),
+           f"ranking: the simd backend's methods have no lane_efficiency: {ranked}")
+    expect("of its lanes" in dom, "the ranking does not show the simd backend's lane efficiency")
 
     images = re.search(r'<body data-images="(\d+)" data-broken="([^"]*)"', dom)
     expect(images and int(images.group(1)) >= 12, f"too few images on the page: {images and images.group(1)}")

@@ -354,6 +354,32 @@ TEST(Ranking, SimdShareOfPeakIsTheGeometricMeanPerMethod) {
   EXPECT_FALSE(ranking[1]["methods"]["sphere"].contains("of_peak"));  // the scalar backend's
 }
 
+// Issue 73's figure: one thread's rays a second over the scalar backend's, over the lanes, per
+// case; its geometric mean per method, over the cases the scalar backend ran too.
+TEST(Ranking, SimdLaneEfficiencyIsOneThreadOverScalarOverLanes) {
+  json cases = json::array();
+  // x: 4e6 rays/s on one thread against the scalar 1e6, 16 lanes: 0.25. y: its frames ran on one
+  // thread (no one_thread_rays_per_s), 8e6 against 1e6: 0.5. z: no scalar case, left out.
+  cases.push_back(matrix_case("simd", "sphere", "x", 7e6, true, 10));
+  cases.back()["counters"]["one_thread_rays_per_s"] = 4e6;
+  cases.back()["counters"]["lanes"] = 16;
+  cases.push_back(matrix_case("scalar", "sphere", "x", 1e6, true, 10));
+  cases.push_back(matrix_case("simd", "sphere", "y", 8e6, true, 10));
+  cases.back()["counters"]["lanes"] = 16;
+  cases.push_back(matrix_case("scalar", "sphere", "y", 1e6, true, 10));
+  cases.push_back(matrix_case("simd", "sphere", "z", 8e6, true, 10));
+  cases.back()["counters"]["lanes"] = 16;
+  EXPECT_DOUBLE_EQ(lane_efficiency(cases[0]["counters"], 1e6), 0.25);
+  EXPECT_DOUBLE_EQ(lane_efficiency(cases[0]["counters"], 0.0), 0.0);  // no scalar figure
+  EXPECT_DOUBLE_EQ(lane_efficiency(cases[1]["counters"], 1e6), 0.0);  // no lanes: not SIMD
+  const json ranking = rank_backends({{"cases", cases}});
+  ASSERT_EQ(ranking[0]["backend"], "simd");
+  const json& sphere = ranking[0]["methods"]["sphere"];
+  EXPECT_NEAR(sphere["lane_efficiency"].get<double>(), std::sqrt(0.25 * 0.5), 1e-12);
+  EXPECT_EQ(sphere["lane_efficiency_cases"], 2);
+  EXPECT_FALSE(ranking[1]["methods"]["sphere"].contains("lane_efficiency"));
+}
+
 TEST(Gate, DeterministicFiguresAreHeldToTheirTolerance) {
   const json fingerprint = {{"cpu", {{"model", "test"}}}};
   json before = {
