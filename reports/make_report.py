@@ -384,7 +384,6 @@ def ranking_section(results):
             peak = f', {pct(mm["of_peak"])} of peak' if mm and "of_peak" in mm else ""
             if mm and "lane_efficiency" in mm:
                 peak += f', {pct(mm["lane_efficiency"])} of its lanes'
-
             row.append(f'{mrays(mm["rays_per_s"])} ({int(mm["passed"])}/{int(mm["cases"])} pass{peak})'
                        if mm else "-")
         row.append(b["best_method"] or "-")
