@@ -99,7 +99,10 @@ struct Tuning {
 // - no gathers in a step but the gluing by slot's one (a gather is slow on every CPU measured:
 //   6 ns for 16 lanes on Zen 5, and SSE4 has none): lookups in vectors or broadcasts blended by
 //   lane instead; gluings by slot need the tints in two vectors (AVX-512, AVX2; SSE4's 4 lanes
-//   hold 8, under the staircases' 10, and keep the rounds).
+//   hold 8, under the staircases' 10, and keep the rounds);
+// - and one compile for all: packet.cpp at -O2 in every build (backends/CMakeLists.txt), since
+//   -O3 took 1.14x the time on each of the three (24 cases, Zen 5; 1.01x, analytic 1.04-1.17x,
+//   on a Zen 4's AVX-512).
 inline constexpr std::array<Tuning, 3> kTunings{{
     {.refill_at = 4,
      .refill_spread = 6,
