@@ -103,31 +103,11 @@ struct Tuning {
 // - and one compile for all: packet.cpp at -O2 in every build (backends/CMakeLists.txt), since
 //   -O3 took 1.14x the time on each of the three (24 cases, Zen 5; 1.01x, analytic 1.04-1.17x,
 //   on a Zen 4's AVX-512).
+// The rows: the defaults above where an instruction set keeps them, and what it sets apart.
 inline constexpr std::array<Tuning, 3> kTunings{{
-    {.refill_at = 4,
-     .refill_spread = 6,
-     .patience = 16,
-     .patience_two_rooms = 48,
-     .most_vectors = 2,
-     .most_vectors_analytic = 2,
-     .rooms_per_pass = 8,
-     .nearest_line = true},  // avx512
-    {.refill_at = 4,
-     .refill_spread = 6,
-     .patience = 16,
-     .patience_two_rooms = 48,
-     .most_vectors = 2,
-     .most_vectors_analytic = 3,
-     .rooms_per_pass = 8,
-     .nearest_line = true},  // avx2
-    {.refill_at = 4,
-     .refill_spread = 6,
-     .patience = 16,
-     .patience_two_rooms = 48,
-     .most_vectors = 2,
-     .most_vectors_analytic = 2,
-     .rooms_per_pass = 8,
-     .nearest_line = false},  // sse4
+    {.nearest_line = true},                              // avx512
+    {.most_vectors_analytic = 3, .nearest_line = true},  // avx2
+    {},                                                  // sse4
 }};
 
 // The tuning of `isa`: kTunings', or, in a build with FLATMARCH_SIMD_TUNING_PROBE defined (for
