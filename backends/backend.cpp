@@ -166,6 +166,12 @@ std::vector<std::string> kernel_backend_names() {
   return names;
 }
 
+const BackendEntry* find_backend_entry(const std::string& name) {
+  for (const BackendEntry& e : registry())
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
 std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOptions& options) {
   for (const BackendEntry& e : registry())
     if (e.name == name) return e.make(options);

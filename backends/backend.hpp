@@ -272,6 +272,9 @@ struct BackendEntry {
   std::function<std::vector<std::pair<std::string, BackendOptions>>()> variants{};
   // The options it takes beyond the march parameters.
   std::vector<BackendOption> options{};
+  // Why its results are wrong on purpose, if they are (the test programs' `faulty` backend):
+  // conformance must fail it on every case; the contract and stability tests skip it, saying so.
+  std::string wrong_on_purpose{};
 };
 
 // The registered backends: the built-in ones, then any a program added.
@@ -283,6 +286,8 @@ bool register_backend(BackendEntry entry);
 // The names of the registered backends, and of those that run the kernel.
 std::vector<std::string> backend_names();
 std::vector<std::string> kernel_backend_names();
+// The registry's entry of that name; null if there is none.
+const BackendEntry* find_backend_entry(const std::string& name);
 
 // All registered backends, available here or not, with default options.
 const std::vector<std::unique_ptr<Backend>>& backends();

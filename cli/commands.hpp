@@ -1,9 +1,19 @@
 // The subcommands of `flatmarch` (DESIGN.md section 5), one file each.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <CLI/CLI.hpp>
 
 namespace flatmarch::cli {
+
+// Runs the command line `argv` (argv[0] the program's name) and returns its exit status. `self`:
+// the command that runs this command line again, for the workers of supervised runs (the
+// flatmarch program: itself; a test program: itself and the argument that makes it a CLI).
+int run(int argc, char** argv, std::vector<std::string> self);
+// This program's own file (/proc/self/exe), else `argv0`.
+std::string this_program(const char* argv0);
 
 void add_inspect(CLI::App& app);
 void add_render(CLI::App& app);

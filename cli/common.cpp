@@ -1,11 +1,14 @@
 #include "cli/common.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -72,6 +75,82 @@ std::pair<int, int> parse_size(const std::string& option, const std::string& tex
     throw UsageError(option + ": expected WxH with 1 <= W, H <= " + std::to_string(kMax) +
                      ", got \"" + text + "\"");
   return {w, h};
+}
+
+namespace {
+std::vector<std::string> g_self, g_args;
+}  // namespace
+
+void set_self_command(std::vector<std::string> self, int argc, char** argv) {
+  g_self = std::move(self);
+  g_args.assign(argv + std::min(argc, 1), argv + argc);
+}
+
+std::vector<std::string> worker_command() {
+  std::vector<std::string> command = g_self;
+  command.insert(command.end(), g_args.begin(), g_args.end());
+  command.emplace_back("--worker");
+  return command;
+}
+
+std::string quoted_command_line(const std::string& extra) {
+  std::vector<std::string> args = g_args;
+  if (!extra.empty() && std::find(args.begin(), args.end(), extra) == args.end())
+    args.push_back(extra);
+  std::string line;
+  for (const std::string& a : args) {
+    const bool plain = !a.empty() && std::all_of(a.begin(), a.end(), [](char ch) {
+      return std::isalnum(static_cast<unsigned char>(ch)) || std::strchr("-_./=:,+@%", ch);
+    });
+    std::string quoted = "'";
+    for (const char ch : a) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    line += (line.empty() ? "" : " ") + (plain ? a : quoted + "'");
+  }
+  return line;
+}
+
+std::string this_program(const char* argv0) {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::string(argv0) : self.string();
+}
+
+MemoryLimit memory_limit() {
+  MemoryLimit m;
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && page > 0) m = {static_cast<double>(pages) * static_cast<double>(page),
+                                  "this machine's physical memory"};
+  const auto lower = [&m](double bytes, const char* what) {
+    if (bytes > 0.0 && (m.bytes == 0.0 || bytes < m.bytes)) m = {bytes, what};
+  };
+  // cgroup v2 (a container's or a Slurm job's limit): a number of bytes, or "max".
+  if (std::ifstream in("/sys/fs/cgroup/memory.max"); in) {
+    std::string text;
+    in >> text;
+    if (!text.empty() && std::all_of(text.begin(), text.end(), ::isdigit))
+      lower(std::stod(text), "its cgroup's memory.max");
+  }
+  if (rlimit as{}; getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY)
+    lower(static_cast<double>(as.rlim_cur), "its address-space limit (RLIMIT_AS)");
+  return m;
+}
+
+void check_frame_memory(const std::string& option, int w, int h, int frames,
+                        const std::string& work) {
+  const MemoryLimit limit = memory_limit();
+  const double need = kFrameBytesPerPixel * w * h * frames;
+  if (limit.bytes == 0.0 || need <= limit.bytes) return;
+  const auto gib = [](double bytes) {
+    std::ostringstream s;
+    s.precision(3);
+    s << bytes / (1024.0 * 1024.0 * 1024.0) << " GiB";
+    return s.str();
+  };
+  throw UsageError(option + " " + std::to_string(w) + "x" + std::to_string(h) + ": " + work +
+                   " at this size holds about " + std::to_string(frames) + " frames of " +
+                   std::to_string(static_cast<int>(kFrameBytesPerPixel)) + " bytes a pixel, " +
+                   gib(need) + ", more than the " + gib(limit.bytes) + " of " + limit.what +
+                   "; choose a smaller size");
 }
 
 void MarchOptions::add_to(CLI::App& app, const std::string& default_name,
@@ -387,9 +466,18 @@ nlohmann::json read_json(const std::string& option, const std::filesystem::path&
 
 void write_json(const std::filesystem::path& file, const nlohmann::json& doc) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-  std::ofstream out(file);
-  out << doc.dump(1) << "\n";
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  // Whole or not at all: written beside it, then renamed over it, so that a run stopped while
+  // writing leaves the file it had (or none), never half of one.
+  const std::filesystem::path partial = file.string() + ".partial";
+  {
+    std::ofstream out(partial);
+    out << doc.dump(1) << "\n";
+    out.flush();
+    if (!out) throw std::runtime_error("cannot write " + partial.string());
+  }
+  std::error_code error;
+  std::filesystem::rename(partial, file, error);
+  if (error) throw std::runtime_error("cannot write " + file.string() + ": " + error.message());
 }
 
 }  // namespace flatmarch::cli

@@ -37,6 +37,33 @@ class ConformanceFailure : public std::runtime_error {
 Vec3 parse_vec3(const std::string& option, const std::string& text);
 std::pair<int, int> parse_size(const std::string& option, const std::string& text);
 
+// The command line this process runs (cli::run's), for supervised runs' workers: set_self_command
+// records it; worker_command is the same command line, run again by `self`, with `--worker`.
+void set_self_command(std::vector<std::string> self, int argc, char** argv);
+std::vector<std::string> worker_command();
+// The command line as a person would type it again (arguments quoted for a shell where they need
+// it), with `extra` added unless it is there: "conform --scene torus --resume".
+std::string quoted_command_line(const std::string& extra);
+
+// What one frame holds a pixel (Frame: linear colour, steps, crossings, hit, t and the 8-bit
+// sRGB), and about how many frames a piece of work holds at once: a rendered image (the frame
+// and the image written from it) and a conformance case (the backend's frame, the oracle's, the
+// float64 reference, the error images and their differences).
+inline constexpr double kFrameBytesPerPixel = 32.0;
+inline constexpr int kRenderFrames = 2;
+inline constexpr int kCaseFrames = 8;
+// The memory this process may use: the least of the machine's physical memory, its cgroup's
+// memory.max and its address-space limit (RLIMIT_AS), with which of them that is.
+struct MemoryLimit {
+  double bytes = 0.0;
+  std::string what;
+};
+MemoryLimit memory_limit();
+// Refuses (UsageError, exit 2) a size whose work would not fit in memory_limit(), before
+// anything is allocated, saying how much it would need: `frames` frames of w x h (`work` names
+// them: "a conformance case").
+void check_frame_memory(const std::string& option, int w, int h, int frames, const std::string& work);
+
 // The scenes named by --scene (a file, or a scene's name in one of the --gallery folders) or,
 // when none is named, every scene of the folders, each folder's sorted by file name. UsageError
 // when a name is found nowhere or the folders hold no scene.

@@ -4,7 +4,9 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <map>
 #include <optional>
+#include <sstream>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
@@ -12,6 +14,8 @@
 #include "output/image_io.hpp"
 #include "reports/fingerprint.hpp"
 #include "reports/shard.hpp"
+#include "reports/journal.hpp"
+#include "reports/supervise.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::cli {
@@ -36,6 +40,54 @@ std::string failures_summary(const conformance::CaseResult& r) {
            ":" + std::to_string(n);
   }
   return s.empty() ? "-" : s;
+}
+
+// The table's lines for a case: its row, then its limit or the checks it failed.
+std::string table_lines(const conformance::CaseResult& r) {
+  int diverged = 0;
+  for (const auto& t : r.traces) diverged += t.failure.has_value();
+  char row[512];
+  std::snprintf(
+      row, sizeof row, "%-8s %-30s %-9s %7s %8s %8s %7s %7.3f %3d/%-2zu  %-24s %s\n",
+      r.backend.c_str(), r.scene.c_str(), to_string(r.params.method),
+      percent(static_cast<double>(r.aov.ambiguous) / static_cast<double>(r.aov.pixels)).c_str(),
+      percent(r.aov.hit_rate()).c_str(), percent(r.aov.crossings_rate()).c_str(),
+      percent(static_cast<double>(r.image.fail) / static_cast<double>(r.image.pixels)).c_str(),
+      r.steps_ks, diverged, r.traces.size(), failures_summary(r).c_str(),
+      r.verdict == conformance::Verdict::pass    ? "pass"
+      : r.verdict == conformance::Verdict::limit ? "limit"
+                                                 : "FAIL");
+  std::string lines = row;
+  if (r.verdict == conformance::Verdict::limit) lines += "    " + r.limit + "\n";
+  for (const std::string& line : r.failed_checks()) lines += "    " + line + "\n";
+  return lines;
+}
+
+// The table's lines for a case that ended without a result: what ended it, and the end of what
+// its worker wrote on its standard error.
+std::string unfinished_lines(const std::string& key, const nlohmann::json& record) {
+  const std::string verdict = record.value("verdict", "error");
+  std::string what = verdict == reports::kVerdictCrash      ? "CRASH"
+                     : verdict == reports::kVerdictTimeout  ? "TIMEOUT"
+                     : verdict == reports::kVerdictOutOfMemory ? "OUT OF MEMORY"
+                                                            : "ERROR";
+  if (record.contains("signal_name")) what += " (" + record["signal_name"].get<std::string>() + ")";
+  if (record.contains("exit_code"))
+    what += " (exit " + std::to_string(record["exit_code"].get<int>()) + ")";
+  if (record.contains("error")) what += ": " + record["error"].get<std::string>();
+  char seconds[64];
+  std::snprintf(seconds, sizeof seconds, " after %.1f s", record.value("seconds", 0.0));
+  if (verdict != "error") what += seconds;
+  if (record.contains("deadline_seconds")) what += ", its deadline";
+  std::string lines = key + "  " + what + "\n";
+  // The last lines its worker wrote, indented.
+  std::vector<std::string> tail;
+  std::istringstream in(record.value("stderr_tail", ""));
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) tail.push_back(line);
+  for (size_t k = tail.size() > 6 ? tail.size() - 6 : 0; k < tail.size(); ++k)
+    lines += "    | " + tail[k] + "\n";
+  return lines;
 }
 
 }  // namespace
@@ -68,6 +120,10 @@ void add_conform(CLI::App& app) {
     std::string shard;
     bool quiet = false;
     bool strict = false;
+    std::string isolate = "worker";
+    double deadline_scale = 10.0, deadline_floor = 30.0, worker_memory_gib = 0.0;
+    bool worker = false;
+    bool resume = false;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("--backend", o->backends,
@@ -96,11 +152,36 @@ void add_conform(CLI::App& app) {
                   "I/N: run only shard I of N of the cases (split by their expected cost, the same "
                   "in every shard), for a scheduler to run the shards apart; `flatmarch merge` "
                   "puts their JSON back together");
+  cmd->add_option("--isolate", o->isolate,
+                  "worker: the cases run in a worker process, watched, so that a case that "
+                  "crashes, overruns its deadline or runs out of memory is recorded as crash, "
+                  "timeout or out_of_memory and a fresh worker goes on; none: in this process "
+                  "(for a debugger)")
+      ->check(CLI::IsMember({"worker", "none"}))
+      ->capture_default_str();
+  cmd->add_option("--deadline-scale", o->deadline_scale,
+                  "A case's deadline: this many times what the cost model expects of it ...")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+  cmd->add_option("--deadline-floor", o->deadline_floor, "... and at least this many seconds")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  cmd->add_option("--worker-memory", o->worker_memory_gib,
+                  "A worker's address-space limit in GiB (default: the machine's memory, or the "
+                  "cgroup's or this process's limit where lower)")
+      ->check(CLI::Range(0.25, 65536.0));
+  cmd->add_flag("--resume", o->resume,
+                "Finish a run that was stopped: the cases in the journal beside --json "
+                "(JSON.journal, each case appended as it finishes) are kept, the others run; the "
+                "same command line otherwise");
+  cmd->add_flag("--worker", o->worker)->group("");  // a worker of a supervised run (hidden)
   cmd->add_flag("-q,--quiet", o->quiet, "Only the summary line");
   cmd->add_flag("--strict", o->strict,
                 "Exit 1 when a case is at its method's limit too, not only when one fails");
   cmd->callback([o] {
-    const auto [w, h] = parse_size("--size", o->size);
+    const std::pair<int, int> size = parse_size("--size", o->size);
+    const int w = size.first, h = size.second;
+    check_frame_memory("--size", w, h, kCaseFrames, "a conformance case");
     check_march_params(o->params);
     check_backend_options(o->backend_options);
     o->params.precision = parse_precision(o->precision);
@@ -161,7 +242,7 @@ void add_conform(CLI::App& app) {
           std::find(precisions.begin(), precisions.end(), o->params.precision) == precisions.end())
         skip = "does not march in " + o->precision;
       if (!skip.empty()) {
-        std::printf("%-8s skipped: %s\n", name.c_str(), skip.c_str());
+        if (!o->worker) std::printf("%-8s skipped: %s\n", name.c_str(), skip.c_str());
         out["skipped"].push_back({{"backend", name}, {"reason", skip}});
         continue;
       }
@@ -179,59 +260,168 @@ void add_conform(CLI::App& app) {
       out["shard"] = plan.record;
       std::fprintf(stderr, "conform: %s\n", plan.summary.c_str());
     }
+    // The cases this shard holds, in order.
+    struct Case {
+      std::string key;
+      const Backend* backend;
+      const Scene* scene;
+      Method method;
+      double cost;
+    };
+    std::vector<Case> held;
+    {
+      size_t k = 0;
+      for (const auto& backend : backends)
+        for (const Scene& scene : scenes)
+          for (const Method m : methods) {
+            const auto& [key, cost] = run[k++];
+            if (plan.holds(key)) held.push_back({key, backend.get(), &scene, m, cost});
+          }
+    }
+    // One case, run here: its record (conformance::to_json's, with its table lines apart).
+    const auto run_case = [&](const Case& c) {
+      MarchParams params = o->params;
+      params.method = c.method;
+      nlohmann::json record;
+      try {
+        const conformance::CaseResult r = suite.run(*c.backend, *c.scene, params, w, h);
+        record = conformance::to_json(r);
+        record["table"] = table_lines(r);
+        if (error_images) {
+          const fs::path file = fs::path(o->error_images) / (c.backend->name() + "-" +
+                                                             c.scene->name + "-" +
+                                                             to_string(c.method) + ".png");
+          write_png(conformance::error_image(r.pixel_classes,
+                                             suite.truth_frame(*c.scene, params, w, h)),
+                    file);
+          record["error_image"] = file.string();
+        }
+      } catch (const std::bad_alloc&) {
+        throw;  // a worker answers out_of_memory
+      } catch (const std::exception& e) {
+        record = {{"backend", c.backend->name()},
+                  {"scene", c.scene->name},
+                  {"method", to_string(c.method)},
+                  {"error", e.what()}};
+      }
+      return record;
+    };
+    if (o->worker) {
+      reports::serve_cases([&](const std::string& key) {
+        for (const Case& c : held)
+          if (c.key == key) return run_case(c);
+        throw std::invalid_argument("worker: no case " + key + " in this run");
+      });
+      return;
+    }
     if (!o->quiet)
       std::printf("%-8s %-30s %-9s %7s %8s %8s %7s %7s %6s  %-24s %s\n", "backend", "scene",
                   "method", "ambig%", "hit%", "cross%", "img%", "stepKS", "traces", "failures",
                   "verdict");
-    for (const auto& backend : backends) {
-      const std::string name = backend->name();
-      for (const Scene& scene : scenes)
-        for (const Method m : methods) {
-          if (!plan.holds(name + "/" + to_string(m) + "/" + scene.name)) continue;
-          MarchParams params = o->params;
-          params.method = m;
-          const conformance::CaseResult r = suite.run(*backend, scene, params, w, h);
-          if (shard && !o->quiet)
-            std::fprintf(stderr, "conform: shard %s: case %d of %zu\n", shard->text().c_str(),
-                         cases + 1, out["shard"]["holds"].size());
-          ++cases;
-          failed += r.verdict == conformance::Verdict::fail;
-          limits += r.verdict == conformance::Verdict::limit;
-          out["cases"].push_back(conformance::to_json(r));
-          if (error_images) {
-            const fs::path file =
-                fs::path(o->error_images) / (name + "-" + scene.name + "-" + to_string(m) + ".png");
-            write_png(
-                conformance::error_image(r.pixel_classes, suite.truth_frame(scene, params, w, h)),
-                file);
-            out["cases"].back()["error_image"] = file.string();
-          }
-          if (o->quiet) continue;
-          int diverged = 0;
-          for (const auto& t : r.traces) diverged += t.failure.has_value();
-          std::printf(
-              "%-8s %-30s %-9s %7s %8s %8s %7s %7.3f %3d/%-2zu  %-24s %s\n", name.c_str(),
-              scene.name.c_str(), to_string(m),
-              percent(static_cast<double>(r.aov.ambiguous) / static_cast<double>(r.aov.pixels))
-                  .c_str(),
-              percent(r.aov.hit_rate()).c_str(), percent(r.aov.crossings_rate()).c_str(),
-              percent(static_cast<double>(r.image.fail) / static_cast<double>(r.image.pixels))
-                  .c_str(),
-              r.steps_ks, diverged, r.traces.size(), failures_summary(r).c_str(),
-              r.verdict == conformance::Verdict::pass    ? "pass"
-              : r.verdict == conformance::Verdict::limit ? "limit"
-                                                         : "FAIL");
-          if (r.verdict == conformance::Verdict::limit) std::printf("    %s\n", r.limit.c_str());
-          for (const std::string& line : r.failed_checks()) std::printf("    %s\n", line.c_str());
-          std::fflush(stdout);
+    // The journal beside the output: a new one, or the stopped run's to resume.
+    std::vector<std::string> keys;
+    for (const Case& c : held) keys.push_back(c.key);
+    nlohmann::json options = out["options"];
+    if (shard) options["shard"] = plan.record;
+    const nlohmann::json header =
+        reports::journal_header("conform", out["fingerprint"], options, keys);
+    std::map<std::string, nlohmann::json> records;
+    std::optional<reports::Journal> journal;
+    try {
+      const fs::path path = o->json + ".journal";
+      journal.emplace(o->resume ? reports::Journal::resume(path, header, records)
+                                : reports::Journal::start(path, header));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string(o->resume ? "--resume: " : "") + e.what());
+    }
+    if (o->resume && !o->quiet)
+      std::fprintf(stderr, "conform: resuming %s: %zu of %zu cases done\n",
+                   journal->path().c_str(), records.size(), held.size());
+    int unfinished = 0;
+    const auto show = [&](const Case& c, const nlohmann::json& record) {
+      if (shard && !o->quiet)
+        std::fprintf(stderr, "conform: shard %s: case %d of %zu\n", shard->text().c_str(),
+                     cases + 1, out["shard"]["holds"].size());
+      ++cases;
+      const std::string verdict = record.contains("error") ? "error" : record.value("verdict", "");
+      failed += verdict == "fail";
+      limits += verdict == "limit";
+      const bool finished = verdict == "pass" || verdict == "limit" || verdict == "fail";
+      unfinished += !finished;
+      if (o->quiet) return;
+      std::fputs(finished ? record.value("table", "").c_str()
+                          : unfinished_lines(c.key, record).c_str(),
+                 stdout);
+      std::fflush(stdout);
+    };
+    // A case finished (here, by a worker, or by a supervisor that saw it fail): journaled, shown.
+    const auto take = [&](const Case& c, nlohmann::json record) {
+      if (!record.contains("backend")) {
+        record["backend"] = c.backend->name();
+        record["scene"] = c.scene->name;
+        record["method"] = to_string(c.method);
+      }
+      journal->append(c.key, record);
+      show(c, record);
+      records[c.key] = std::move(record);
+    };
+    std::vector<const Case*> to_run;
+    for (const Case& c : held) {
+      if (const auto it = records.find(c.key); it != records.end())
+        show(c, it->second);
+      else
+        to_run.push_back(&c);
+    }
+    const std::string resume_hint = "flatmarch " + quoted_command_line("--resume");
+    try {
+      const reports::StopSignals stop;
+      if (o->isolate == "none") {
+        for (const Case* c : to_run) {
+          if (const int sig = reports::StopSignals::stop_requested())
+            throw reports::Interrupted(sig);
+          take(*c, run_case(*c));
         }
+      } else {
+        reports::WorkerOptions workers;
+        workers.argv = worker_command();
+        workers.memory_bytes = o->worker_memory_gib > 0.0
+                                   ? o->worker_memory_gib * 1024.0 * 1024.0 * 1024.0
+                                   : std::max(memory_limit().bytes, 8.0 * 1024 * 1024 * 1024);
+        std::vector<reports::SupervisedCase> supervised;
+        for (const Case* c : to_run)
+          supervised.push_back(
+              {c->key, reports::case_deadline(c->cost, o->deadline_scale, o->deadline_floor)});
+        size_t next = 0;
+        reports::supervise(workers, supervised,
+                           [&](const std::string&, const nlohmann::json& record) {
+                             take(*to_run[next++], record);
+                           });
+      }
+    } catch (const reports::Interrupted& e) {
+      std::fprintf(stderr,
+                   "conform: %s after %zu of %zu cases; the journal %s keeps them: resume with\n"
+                   "  %s\n",
+                   e.what(), records.size(), held.size(), journal->path().c_str(),
+                   resume_hint.c_str());
+      throw;
+    }
+    for (const Case& c : held) {
+      nlohmann::json record = records.at(c.key);
+      record.erase("table");
+      out["cases"].push_back(std::move(record));
     }
     if (!no_images.empty())
       out["unmeasured"] =
           nlohmann::json::array({{{"check", "image.perceptual_failpercent"}, {"why", no_images}}});
-    std::ofstream(o->json) << out.dump(1) << "\n";
-    std::printf("%d cases: %d pass, %d at their method's limit, %d failed; wrote %s\n", cases,
-                cases - failed - limits, limits, failed, o->json.c_str());
+    write_json(o->json, out);
+    journal->complete();
+    std::printf("%d cases: %d pass, %d at their method's limit, %d failed%s; wrote %s\n", cases,
+                cases - failed - limits - unfinished, limits, failed,
+                unfinished ? (", " + std::to_string(unfinished) +
+                              " did not finish (crash, timeout, out of memory or error)")
+                                 .c_str()
+                           : "",
+                o->json.c_str());
     if (!no_images.empty())
       say_left_out("conform",
                    o->error_images.empty() ? "Yee's perceptual check"
@@ -241,9 +431,9 @@ void add_conform(CLI::App& app) {
                             ? ""
                             : "; `flatmarch conform --error-images DIR` on a machine with "
                               "OpenImageIO (ci/install-deps.sh installs it) draws the images"));
-    if (failed)
-      throw ConformanceFailure(std::to_string(failed) + " of " + std::to_string(cases) +
-                               " cases failed");
+    if (failed || unfinished)
+      throw ConformanceFailure(std::to_string(failed + unfinished) + " of " +
+                               std::to_string(cases) + " cases failed or did not finish");
     if (limits && o->strict)
       throw ConformanceFailure(std::to_string(limits) + " of " + std::to_string(cases) +
                                " cases are at their method's limit (--strict)");

@@ -36,6 +36,7 @@ void add_gallery(CLI::App& app) {
   o->march.add_to(*cmd);
   cmd->callback([o] {
     const auto [w, h] = parse_size("--size", o->size);
+    check_frame_memory("--size", w, h, kRenderFrames, "a rendered image");
     const Backend& backend = o->march.resolve();
     std::error_code ec;
     if (!fs::is_directory(o->scenes, ec))

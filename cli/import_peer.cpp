@@ -40,7 +40,7 @@ std::string pretty(const Json& j, size_t indent = 0) {
   return out + "\n" + std::string(indent, ' ') + (j.is_array() ? "]" : "}");
 }
 
-void write_json(const std::string& path, const Json& doc) {
+void write_pretty_json(const std::string& path, const Json& doc) {
   std::ofstream out(path);
   out << pretty(doc) << "\n";
   if (!out.flush()) throw UsageError("cannot write " + path);
@@ -71,7 +71,7 @@ void add_import_peer(CLI::App& app) {
     if (o->out.empty())
       std::cout << pretty(result.scene) << "\n";
     else
-      write_json(o->out, result.scene);
+      write_pretty_json(o->out, result.scene);
     std::map<std::string, int> counts;
     for (const PeerFinding& f : result.findings) {
       std::cerr << o->file << ": " << f.pointer << ": " << to_string(f.severity) << ": "
@@ -84,7 +84,7 @@ void add_import_peer(CLI::App& app) {
     std::cerr << o->file << ": converted to scene \"" << result.scene["name"].get<std::string>()
               << "\"" << (summary.empty() ? "" : " (" + summary + ")") << "\n";
     if (!o->report.empty())
-      write_json(o->report, {{"file", o->file}, {"findings", findings_json(result.findings)}});
+      write_pretty_json(o->report, {{"file", o->file}, {"findings", findings_json(result.findings)}});
   });
 }
 

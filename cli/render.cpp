@@ -34,6 +34,7 @@ void add_render(CLI::App& app) {
   o->camera.add_to(*cmd);
   cmd->callback([o] {
     const auto [w, h] = parse_size("--size", o->size);
+    check_frame_memory("--size", w, h, kRenderFrames, "a rendered image");
     const Backend& backend = o->march.resolve();
     const Scene scene = load_scene(o->scene);
     const Camera camera = o->camera.apply(scene);

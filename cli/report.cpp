@@ -244,6 +244,9 @@ void add_report(CLI::App& app) {
         parse_size("--size", o->size.empty() ? (o->full ? "640x360" : "256x144") : o->size);
     std::tie(r.matrix.conform_width, r.matrix.conform_height) =
         parse_size("--conform-size", o->conform_size);
+    check_frame_memory("--size", r.matrix.width, r.matrix.height, kRenderFrames, "a timed frame");
+    check_frame_memory("--conform-size", r.matrix.conform_width, r.matrix.conform_height,
+                       kCaseFrames, "a conformance case");
     r.matrix.repetitions = o->repetitions ? o->repetitions : (o->full ? 5 : 3);
     if (r.matrix.repetitions < 2 || r.matrix.repetitions > 100)
       throw UsageError("--repetitions: expected 2 to 100");
@@ -275,6 +278,8 @@ void add_report(CLI::App& app) {
     r.sweep.repetitions = o->full ? 3 : 2;
     std::tie(r.sweep.width, r.sweep.height) = parse_size(
         "--sweep-size", o->sweep_size.empty() ? (o->full ? "96x54" : "64x36") : o->sweep_size);
+    check_frame_memory("--sweep-size", r.sweep.width, r.sweep.height, kCaseFrames,
+                       "a sweep point's conformance case");
 
     r.scaling_enabled = !o->no_scaling;
     r.scaling.methods = r.matrix.methods;

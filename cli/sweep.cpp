@@ -55,6 +55,8 @@ void add_sweep(CLI::App& app) {
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
     std::tie(o->sweep.width, o->sweep.height) = parse_size("--size", o->size);
+    check_frame_memory("--size", o->sweep.width, o->sweep.height, kCaseFrames,
+                       "a sweep point's conformance case");
     o->sweep.methods = parse_methods(o->methods);
     if (!o->precisions.empty()) {
       o->sweep.precisions.clear();

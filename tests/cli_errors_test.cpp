@@ -422,6 +422,47 @@ std::vector<ArgCase> shared_option_cases() {
 INSTANTIATE_TEST_SUITE_P(SharedOptions, BadArguments, testing::ValuesIn(shared_option_cases()),
                          [](const testing::TestParamInfo<ArgCase>& p) { return p.param.name; });
 
+// A size whose work would not fit in memory is refused before anything is allocated, with how
+// much it would need, under an address-space limit that the same command well within it meets.
+TEST(Cli, ASizeBeyondMemoryIsRefusedBeforeItAllocates) {
+#ifdef FLATMARCH_SANITIZE_BUILD
+  GTEST_SKIP() << "a sanitizer reserves terabytes of address space: no RLIMIT_AS can hold it";
+#endif
+  const std::string dir = test::make_temp_dir();
+  const std::string limit = "--as=" + std::to_string(size_t{3} << 30);  // 3 GiB
+  const std::string scenes = FLATMARCH_SOURCE_DIR "/scenes";
+  const std::vector<std::pair<std::vector<std::string>, std::string>> commands{
+      // 8192 x 4096 x 8 frames x 32 bytes = 8 GiB
+      {{"conform", "--scene", "torus", "--gallery", scenes, "--backend", "scalar", "--size",
+        "8192x4096", "--json", dir + "/x.json"},
+       "--size 8192x4096: a conformance case at this size holds about 8 frames of 32 bytes a "
+       "pixel, 8 GiB, more than the 3 GiB of its address-space limit (RLIMIT_AS)"},
+      {{"sweep", "--scene", "torus", "--gallery", scenes, "--size", "8192x4096", "--json",
+        dir + "/x.json"},
+       "--size 8192x4096: a sweep point's conformance case"},
+      {{"report", "--out", dir, "--gallery", scenes, "--sweep-size", "8192x4096"},
+       "--sweep-size 8192x4096"},
+      // 16384 x 16384 x 2 frames x 32 bytes = 16 GiB
+      {{"render", FLATMARCH_SOURCE_DIR "/scenes/torus.json", "-o", dir + "/x.png", "--size",
+        "16384x16384"},
+       "--size 16384x16384: a rendered image"}};
+  for (const auto& [args, fragment] : commands) {
+    std::vector<std::string> argv{"prlimit", limit, FLATMARCH_BINARY};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const auto r = test::run_process(argv, 30.0);
+    EXPECT_EQ(r.exit_code, 2) << args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(fs::path(dir) / "x.png"));
+  // Within the limit the same command runs.
+  const auto ok = test::run_process({"prlimit", limit, FLATMARCH_BINARY, "conform", "--scene",
+                                     "torus", "--gallery", scenes, "--backend", "scalar",
+                                     "--method", "analytic",
+                                     "--size", "32x18", "--json", dir + "/x.json"},
+                                    120.0);
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
 TEST(Cli, EverySubcommandHasHelp) {
   for (const char* command : {"inspect", "render", "trace", "backends", "gallery", "import-peer",
                               "plan", "shader", "view"}) {

@@ -75,6 +75,16 @@ TEST_P(GalleryConformance, MeetsItsThresholds) {
   params.precision = GetParam().precision;
   const CaseResult r = suite_for(GetParam().scene).run(backend, scene, params, 160, 90);
   std::cout << "[ figures  ] " << to_json(r).dump() << "\n";
+  // A backend wrong on purpose (the test programs' faulty one) must fail every case: the suite
+  // catches a renderer that runs and is wrong.
+  if (const BackendEntry* e = find_backend_entry(GetParam().backend);
+      e && !e->wrong_on_purpose.empty()) {
+    EXPECT_EQ(r.verdict, Verdict::fail)
+        << "the suite passed the " << GetParam().backend << " backend (" << e->wrong_on_purpose
+        << "): " << to_string(r.verdict);
+    EXPECT_FALSE(r.failed_checks().empty());
+    return;
+  }
   // A case at its method's limit is expected (issue 22): it is reported, not counted as a pass,
   // and the regression gate catches it getting worse.
   if (r.verdict == Verdict::limit) std::cout << "[ limit    ] " << r.limit << "\n";

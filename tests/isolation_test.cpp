@@ -1,0 +1,295 @@
+// Supervised cases (reports/supervise.hpp): a case that crashes, hangs or runs out of memory costs
+// only itself. This program is also the command line (`isolation_test --flatmarch-cli ARGS`, its
+// own main below), so that its runs have the test programs' faulty backend and their workers are
+// this program again.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <thread>
+
+#include "cli/commands.hpp"
+#include "reports/supervise.hpp"
+#include "tests/process.hpp"
+
+extern char** environ;
+
+namespace flatmarch {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+constexpr const char* kCliFlag = "--flatmarch-cli";
+
+std::string self() {
+  return cli::this_program("isolation_test");
+}
+
+json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+// A case's deterministic fields: all but its time.
+json deterministic(json c) {
+  c.erase("seconds");
+  return c;
+}
+
+std::string key(const json& c) {
+  return c["backend"].get<std::string>() + "/" + c["method"].get<std::string>() + "/" +
+         c["scene"].get<std::string>();
+}
+
+// `flatmarch conform` over 30 cases: the faulty and scalar backends, five scenes, three methods.
+test::ProcessResult conform(const std::string& json_path, const std::vector<std::string>& more,
+                            const char* faults) {
+  if (faults)
+    setenv("FLATMARCH_FAULTY", faults, 1);
+  else
+    unsetenv("FLATMARCH_FAULTY");
+  std::vector<std::string> argv{self(), kCliFlag, "conform", "--backend", "faulty", "--backend",
+                                "scalar", "--size", "32x18", "--json", json_path,
+                                "--deadline-floor", "3", "--worker-memory", "2", "--gallery",
+                                FLATMARCH_SOURCE_DIR "/scenes"};
+  for (const char* scene : {"torus", "l_shape", "cube", "klein_bottle", "mirror_square"})
+    argv.insert(argv.end(), {"--scene", scene});
+  argv.insert(argv.end(), more.begin(), more.end());
+  test::ProcessResult r = test::run_process(argv, 300.0);
+  unsetenv("FLATMARCH_FAULTY");
+  return r;
+}
+
+TEST(IsolatedConform, ACrashAHangAndAnOutOfMemoryCostOnlyTheirOwnCases) {
+  const std::string dir = test::make_temp_dir();
+#ifdef FLATMARCH_SANITIZE_BUILD
+  // No address-space limit holds a sanitizer's shadow memory: an abort stands in for the
+  // allocation without bound, and only the crash and the hang are checked.
+  const char* faults = "crash=torus/analytic,hang=l_shape/sphere,abort=cube/relaxed";
+#else
+  const char* faults = "crash=torus/analytic,hang=l_shape/sphere,oom=cube/relaxed";
+#endif
+  const test::ProcessResult clean = conform(dir + "/clean.json", {"--isolate", "none"}, nullptr);
+  const test::ProcessResult faulty = conform(dir + "/faulty.json", {}, faults);
+  // Exit 1: the faulty backend fails every case it finishes, and three did not finish.
+  ASSERT_EQ(clean.exit_code, 1) << clean.err;
+  ASSERT_EQ(faulty.exit_code, 1) << faulty.out << faulty.err;
+  const json a = read_json(dir + "/clean.json"), b = read_json(dir + "/faulty.json");
+  ASSERT_EQ(a["cases"].size(), 30u);
+  ASSERT_EQ(b["cases"].size(), 30u);
+  std::map<std::string, json> unfinished;
+  for (size_t k = 0; k < 30; ++k) {
+    const json& c = b["cases"][k];
+    ASSERT_EQ(key(c), key(a["cases"][k])) << "the cases in another order";
+    const std::string verdict = c.value("verdict", "");
+    if (reports::is_supervision_verdict(verdict))
+      unfinished[key(c)] = c;
+    else
+      EXPECT_EQ(deterministic(c), deterministic(a["cases"][k])) << key(c);
+  }
+  ASSERT_EQ(unfinished.size(), 3u) << faulty.out;
+  const json& crash = unfinished["faulty/analytic/torus"];
+  EXPECT_EQ(crash["verdict"], "crash");
+  EXPECT_EQ(crash["signal_name"], "SIGSEGV") << crash.dump();
+  const json& hang = unfinished["faulty/sphere/l_shape"];
+  EXPECT_EQ(hang["verdict"], "timeout");
+  EXPECT_GE(hang["seconds"].get<double>(), 3.0);
+  EXPECT_LT(hang["seconds"].get<double>(), 60.0);
+  const json& third = unfinished["faulty/relaxed/cube"];
+#ifdef FLATMARCH_SANITIZE_BUILD
+  EXPECT_EQ(third["verdict"], "crash");
+#else
+  EXPECT_EQ(third["verdict"], "out_of_memory") << third.dump();
+  EXPECT_EQ(third["memory_limit_bytes"], 2.0 * 1024 * 1024 * 1024);
+#endif
+  // The table says so too, and the summary counts them.
+  EXPECT_NE(faulty.out.find("faulty/analytic/torus  CRASH (SIGSEGV)"), std::string::npos)
+      << faulty.out;
+  EXPECT_NE(faulty.out.find("faulty/sphere/l_shape  TIMEOUT"), std::string::npos);
+  EXPECT_NE(faulty.out.find("3 did not finish"), std::string::npos) << faulty.out;
+}
+
+// `flatmarch conform` of the scalar backend over a few scenes, into `json_path`.
+std::vector<std::string> small_conform(const std::string& json_path) {
+  std::vector<std::string> argv{self(), kCliFlag, "conform", "--backend", "scalar", "--size",
+                                "32x18", "--json", json_path, "-q", "--gallery",
+                                FLATMARCH_SOURCE_DIR "/scenes"};
+  for (const char* scene : {"torus", "l_shape", "klein_bottle"})
+    argv.insert(argv.end(), {"--scene", scene});
+  return argv;
+}
+
+std::vector<std::string> with(std::vector<std::string> argv, const std::string& more) {
+  argv.push_back(more);
+  return argv;
+}
+
+// The cases' keys of a journal's records, in order.
+std::vector<std::string> journal_keys(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> keys;
+  for (std::string line; std::getline(in, line);) {
+    const json j = json::parse(line);
+    if (j.contains("key")) keys.push_back(j["key"]);
+  }
+  return keys;
+}
+
+// Runs stopped by SIGKILL at random moments (the process gone at once, as by a scheduler or a
+// lost machine) and resumed: every one ends with the uninterrupted run's figures, each case
+// measured once.
+TEST(ResumedConform, RunsKilledAtRandomAndResumedEqualAnUninterruptedOne) {
+  const std::string dir = test::make_temp_dir();
+  const auto whole_start = std::chrono::steady_clock::now();
+  const test::ProcessResult whole = test::run_process(small_conform(dir + "/whole.json"), 300.0);
+  const double whole_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - whole_start).count();
+  ASSERT_FALSE(whole.timed_out);
+  ASSERT_LE(whole.exit_code, 1) << whole.err;
+  const json expected = read_json(dir + "/whole.json");
+  ASSERT_EQ(expected["cases"].size(), 9u);
+#ifdef FLATMARCH_SANITIZE_BUILD
+  const int runs = 4;
+#else
+  const int runs = 20;
+#endif
+  std::mt19937 random(74);
+  std::uniform_real_distribution<double> moment(0.02, 1.1 * whole_seconds);
+  int interrupted = 0;
+  for (int run = 0; run < runs; ++run) {
+    const std::string out = dir + "/run-" + std::to_string(run) + ".json";
+    const test::ProcessResult first = test::run_process(small_conform(out), moment(random));
+    interrupted += first.timed_out;
+    // Resumed until it finishes (the first resume does, unless it too is stopped: it is not).
+    const test::ProcessResult rest = test::run_process(with(small_conform(out), "--resume"), 300.0);
+    ASSERT_FALSE(rest.timed_out);
+    ASSERT_LE(rest.exit_code, 1) << rest.err;
+    const json got = read_json(out);
+    ASSERT_EQ(got["cases"].size(), expected["cases"].size()) << "run " << run;
+    for (size_t k = 0; k < got["cases"].size(); ++k)
+      EXPECT_EQ(deterministic(got["cases"][k]), deterministic(expected["cases"][k]))
+          << "run " << run << ", case " << k;
+    // Each case recorded once, none lost: the journal holds every key once.
+    std::vector<std::string> keys = journal_keys(out + ".journal");
+    std::sort(keys.begin(), keys.end());
+    EXPECT_EQ(std::adjacent_find(keys.begin(), keys.end()), keys.end()) << "a case twice";
+    EXPECT_EQ(keys.size(), 9u) << "run " << run;
+  }
+  // Most runs were stopped part way (the moments reach past the run's end for a few).
+  EXPECT_GE(interrupted, runs / 2);
+}
+
+// SIGTERM (a scheduler's notice) and SIGINT (Ctrl-C): the case under way abandoned, the
+// journal closed, how to resume printed, exit 143 or 130; a fresh start then refuses to forget
+// the stopped run, and --resume finishes it.
+TEST(ResumedConform, AStoppedRunSaysHowToResume) {
+  const std::string dir = test::make_temp_dir();
+  setenv("FLATMARCH_FAULTY", "sleep:30=l_shape", 1);  // a case long enough to be stopped in
+  std::vector<std::string> argv{self(), kCliFlag, "conform", "--backend", "faulty", "--size",
+                                "32x18", "--json", dir + "/x.json", "--scene", "torus",
+                                "--scene", "l_shape", "--method", "analytic", "--gallery",
+                                FLATMARCH_SOURCE_DIR "/scenes"};
+  // Started in the background: the test sends the signal.
+  std::vector<char*> args;
+  for (std::string& a : argv) args.push_back(a.data());
+  args.push_back(nullptr);
+  const std::string err_path = dir + "/err";
+  for (const int sig : {SIGTERM, SIGINT}) {
+    fs::remove(dir + "/x.json.journal");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0600);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+    // Until the first case (torus) is in the journal and the second (l_shape) sleeps.
+    for (int k = 0; k < 600 && journal_keys(dir + "/x.json.journal").empty(); ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    const auto sent = std::chrono::steady_clock::now();
+    kill(pid, sig);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+    ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 128 + sig);
+    EXPECT_LT(took, 10.0) << "the case under way was not abandoned";
+    std::ifstream in(err_path);
+    const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(err.find("after 1 of 2 cases"), std::string::npos) << err;
+    EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+    EXPECT_EQ(journal_keys(dir + "/x.json.journal"),
+              std::vector<std::string>{"faulty/analytic/torus"});
+  }
+  unsetenv("FLATMARCH_FAULTY");
+  const std::vector<std::string> again = argv;
+  const test::ProcessResult fresh = test::run_process(again, 60.0);
+  EXPECT_EQ(fresh.exit_code, 2);
+  EXPECT_NE(fresh.err.find("add --resume to finish it"), std::string::npos) << fresh.err;
+  const test::ProcessResult resumed = test::run_process(with(again, "--resume"), 60.0);
+  EXPECT_EQ(resumed.exit_code, 1) << resumed.err;  // the faulty backend fails both cases
+  EXPECT_EQ(read_json(dir + "/x.json")["cases"].size(), 2u);
+}
+
+// A case the worker answers with an error stays an error, not a crash; a worker that cannot be
+// started is an error of the run.
+TEST(Supervise, AWorkerThatCannotStartIsAnError) {
+  reports::WorkerOptions o;
+  o.argv = {"/nonexistent/flatmarch-worker"};
+  EXPECT_THROW(reports::supervise(o, {{"a", 5.0}}, [](const std::string&, const json&) {}),
+               std::runtime_error);
+}
+
+// A worker that answers with something other than a JSON object is an error of the run, and a
+// worker that exits mid-case without a signal is a crash with its exit code.
+TEST(Supervise, AWorkersAnswersAreChecked) {
+  reports::WorkerOptions o;
+  o.argv = {"/bin/sh", "-c", "read k; echo not-json"};
+  EXPECT_THROW(reports::supervise(o, {{"a", 5.0}}, [](const std::string&, const json&) {}),
+               std::runtime_error);
+  o.argv = {"/bin/sh", "-c", "read k; echo '{\"n\": 1}'; read k; echo bye >&2; exit 7"};
+  std::vector<json> records;
+  reports::supervise(o, {{"a", 5.0}, {"b", 5.0}, {"c", 5.0}},
+                     [&](const std::string&, const json& r) { records.push_back(r); });
+  ASSERT_EQ(records.size(), 3u);
+  EXPECT_EQ(records[0], (json{{"n", 1}}));
+  EXPECT_EQ(records[1]["verdict"], "crash");
+  EXPECT_EQ(records[1]["exit_code"], 7);
+  EXPECT_EQ(records[1]["stderr_tail"], "bye\n");
+  EXPECT_EQ(records[2], (json{{"n", 1}}));  // a fresh worker took the next case
+  // A worker that sleeps past the deadline: a timeout, within the deadline and a little.
+  o.argv = {"/bin/sh", "-c", "read k; sleep 30"};
+  o.start_seconds = 0.0;
+  records.clear();
+  reports::supervise(o, {{"a", 0.5}},
+                     [&](const std::string&, const json& r) { records.push_back(r); });
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0]["verdict"], "timeout");
+  EXPECT_LT(records[0]["seconds"].get<double>(), 5.0);
+}
+
+}  // namespace
+}  // namespace flatmarch
+
+int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], flatmarch::kCliFlag) == 0)
+    return flatmarch::cli::run(argc - 1, argv + 1,
+                               {flatmarch::cli::this_program(argv[0]), flatmarch::kCliFlag});
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
