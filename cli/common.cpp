@@ -118,8 +118,8 @@ std::string this_program(const char* argv0) {
 MemoryLimit memory_limit() {
   MemoryLimit m;
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  if (pages > 0 && page > 0) m = {static_cast<double>(pages) * static_cast<double>(page),
-                                  "this machine's physical memory"};
+  if (pages > 0 && page > 0)
+    m = {static_cast<double>(pages) * static_cast<double>(page), "this machine's physical memory"};
   const auto lower = [&m](double bytes, const char* what) {
     if (bytes > 0.0 && (m.bytes == 0.0 || bytes < m.bytes)) m = {bytes, what};
   };

@@ -62,7 +62,8 @@ MemoryLimit memory_limit();
 // Refuses (UsageError, exit 2) a size whose work would not fit in memory_limit(), before
 // anything is allocated, saying how much it would need: `frames` frames of w x h (`work` names
 // them: "a conformance case").
-void check_frame_memory(const std::string& option, int w, int h, int frames, const std::string& work);
+void check_frame_memory(const std::string& option, int w, int h, int frames,
+                        const std::string& work);
 
 // The scenes named by --scene (a file, or a scene's name in one of the --gallery folders) or,
 // when none is named, every scene of the folders, each folder's sorted by file name. UsageError

@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -13,8 +13,8 @@
 #include "conformance/suite.hpp"
 #include "output/image_io.hpp"
 #include "reports/fingerprint.hpp"
-#include "reports/shard.hpp"
 #include "reports/journal.hpp"
+#include "reports/shard.hpp"
 #include "reports/supervise.hpp"
 #include "scene/load.hpp"
 
@@ -67,10 +67,10 @@ std::string table_lines(const conformance::CaseResult& r) {
 // its worker wrote on its standard error.
 std::string unfinished_lines(const std::string& key, const nlohmann::json& record) {
   const std::string verdict = record.value("verdict", "error");
-  std::string what = verdict == reports::kVerdictCrash      ? "CRASH"
-                     : verdict == reports::kVerdictTimeout  ? "TIMEOUT"
+  std::string what = verdict == reports::kVerdictCrash         ? "CRASH"
+                     : verdict == reports::kVerdictTimeout     ? "TIMEOUT"
                      : verdict == reports::kVerdictOutOfMemory ? "OUT OF MEMORY"
-                                                            : "ERROR";
+                                                               : "ERROR";
   if (record.contains("signal_name")) what += " (" + record["signal_name"].get<std::string>() + ")";
   if (record.contains("exit_code"))
     what += " (exit " + std::to_string(record["exit_code"].get<int>()) + ")";
@@ -288,12 +288,12 @@ void add_conform(CLI::App& app) {
         record = conformance::to_json(r);
         record["table"] = table_lines(r);
         if (error_images) {
-          const fs::path file = fs::path(o->error_images) / (c.backend->name() + "-" +
-                                                             c.scene->name + "-" +
-                                                             to_string(c.method) + ".png");
-          write_png(conformance::error_image(r.pixel_classes,
-                                             suite.truth_frame(*c.scene, params, w, h)),
-                    file);
+          const fs::path file =
+              fs::path(o->error_images) /
+              (c.backend->name() + "-" + c.scene->name + "-" + to_string(c.method) + ".png");
+          write_png(
+              conformance::error_image(r.pixel_classes, suite.truth_frame(*c.scene, params, w, h)),
+              file);
           record["error_image"] = file.string();
         }
       } catch (const std::bad_alloc&) {
@@ -335,8 +335,8 @@ void add_conform(CLI::App& app) {
       throw UsageError(std::string(o->resume ? "--resume: " : "") + e.what());
     }
     if (o->resume && !o->quiet)
-      std::fprintf(stderr, "conform: resuming %s: %zu of %zu cases done\n",
-                   journal->path().c_str(), records.size(), held.size());
+      std::fprintf(stderr, "conform: resuming %s: %zu of %zu cases done\n", journal->path().c_str(),
+                   records.size(), held.size());
     int unfinished = 0;
     const auto show = [&](const Case& c, const nlohmann::json& record) {
       if (shard && !o->quiet)
@@ -349,9 +349,9 @@ void add_conform(CLI::App& app) {
       const bool finished = verdict == "pass" || verdict == "limit" || verdict == "fail";
       unfinished += !finished;
       if (o->quiet) return;
-      std::fputs(finished ? record.value("table", "").c_str()
-                          : unfinished_lines(c.key, record).c_str(),
-                 stdout);
+      std::fputs(
+          finished ? record.value("table", "").c_str() : unfinished_lines(c.key, record).c_str(),
+          stdout);
       std::fflush(stdout);
     };
     // A case finished (here, by a worker, or by a supervisor that saw it fail): journaled, shown.

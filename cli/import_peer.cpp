@@ -84,7 +84,8 @@ void add_import_peer(CLI::App& app) {
     std::cerr << o->file << ": converted to scene \"" << result.scene["name"].get<std::string>()
               << "\"" << (summary.empty() ? "" : " (" + summary + ")") << "\n";
     if (!o->report.empty())
-      write_pretty_json(o->report, {{"file", o->file}, {"findings", findings_json(result.findings)}});
+      write_pretty_json(o->report,
+                        {{"file", o->file}, {"findings", findings_json(result.findings)}});
   });
 }
 

@@ -122,8 +122,8 @@ class Worker {
       if (now >= until) return Read::late;
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - now);
       pollfd fds[2] = {{out_, POLLIN, 0}, {err_, POLLIN, 0}};
-      const int ready =
-          ::poll(fds, err_ >= 0 ? 2 : 1, static_cast<int>(std::min<int64_t>(left.count() + 1, 1000)));
+      const int ready = ::poll(fds, err_ >= 0 ? 2 : 1,
+                               static_cast<int>(std::min<int64_t>(left.count() + 1, 1000)));
       if (ready < 0 && errno != EINTR) throw std::runtime_error(system_error("poll"));
       if (ready <= 0) continue;
       if (err_ >= 0 && (fds[1].revents & (POLLIN | POLLHUP))) drain_stderr();
@@ -224,7 +224,8 @@ json failed_case(const char* verdict, int status, double seconds, std::string ta
   if (WIFSIGNALED(status)) {
     r["signal"] = WTERMSIG(status);
     const char* name = sigabbrev_np(WTERMSIG(status));
-    r["signal_name"] = name ? std::string("SIG") + name : "signal " + std::to_string(WTERMSIG(status));
+    r["signal_name"] =
+        name ? std::string("SIG") + name : "signal " + std::to_string(WTERMSIG(status));
   } else if (WIFEXITED(status)) {
     r["exit_code"] = WEXITSTATUS(status);
   }
@@ -265,8 +266,9 @@ extern "C" void note_stop(int signal) {
 }  // namespace
 
 Interrupted::Interrupted(int sig)
-    : std::runtime_error(std::string("interrupted by ") +
-                         (sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal")),
+    : std::runtime_error(std::string("interrupted by ") + (sig == SIGINT    ? "SIGINT"
+                                                           : sig == SIGTERM ? "SIGTERM"
+                                                                            : "a signal")),
       signal(sig) {}
 
 StopSignals::StopSignals() : old_(new struct sigaction[2]) {
@@ -310,10 +312,11 @@ void supervise(const WorkerOptions& options, const std::vector<SupervisedCase>& 
     }
     const auto started = Clock::now();
     const double allowed = c.deadline_seconds + (fresh ? options.start_seconds : 0.0);
-    const auto until =
-        started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(allowed));
+    const auto until = started + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(allowed));
     std::string line;
-    Worker::Read got = worker->send(c.key) ? worker->wait_for_line(until, line) : Worker::Read::gone;
+    Worker::Read got =
+        worker->send(c.key) ? worker->wait_for_line(until, line) : Worker::Read::gone;
     const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
     if (got == Worker::Read::line) {
       json record;

@@ -75,8 +75,9 @@ struct SupervisedCase {
 // where it exited, "deadline_seconds" for a timeout, "stderr_tail"}. Throws std::runtime_error
 // when a worker cannot be started at all, or when it answers a case with something other than
 // one JSON object.
-void supervise(const WorkerOptions& options, const std::vector<SupervisedCase>& cases,
-               const std::function<void(const std::string& key, const nlohmann::json& record)>& done);
+void supervise(
+    const WorkerOptions& options, const std::vector<SupervisedCase>& cases,
+    const std::function<void(const std::string& key, const nlohmann::json& record)>& done);
 
 // The worker's side. Sets its own address-space limit as the parent asked (through the
 // environment: FLATMARCH_WORKER_MEMORY; not in a sanitizer build, whose shadow memory needs

@@ -47,9 +47,10 @@ std::vector<Variant> variants() {
 class BackendContract : public testing::TestWithParam<Variant> {
  protected:
   void SetUp() override {
-    if (const BackendEntry* e = find_backend_entry(GetParam().backend); e && !e->wrong_on_purpose.empty())
-      GTEST_SKIP() << "the " << GetParam().backend << " backend breaks the contract on purpose: "
-                   << e->wrong_on_purpose;
+    if (const BackendEntry* e = find_backend_entry(GetParam().backend);
+        e && !e->wrong_on_purpose.empty())
+      GTEST_SKIP() << "the " << GetParam().backend
+                   << " backend breaks the contract on purpose: " << e->wrong_on_purpose;
     backend_ = make_backend(GetParam().backend, GetParam().options);
     ASSERT_NE(backend_, nullptr) << GetParam().backend << " is registered but makes no backend";
     if (const Availability a = backend_->availability(); !a.available)

@@ -455,11 +455,10 @@ TEST(Cli, ASizeBeyondMemoryIsRefusedBeforeItAllocates) {
   }
   EXPECT_FALSE(fs::exists(fs::path(dir) / "x.png"));
   // Within the limit the same command runs.
-  const auto ok = test::run_process({"prlimit", limit, FLATMARCH_BINARY, "conform", "--scene",
-                                     "torus", "--gallery", scenes, "--backend", "scalar",
-                                     "--method", "analytic",
-                                     "--size", "32x18", "--json", dir + "/x.json"},
-                                    120.0);
+  const auto ok = test::run_process(
+      {"prlimit", limit, FLATMARCH_BINARY, "conform", "--scene", "torus", "--gallery", scenes,
+       "--backend", "scalar", "--method", "analytic", "--size", "32x18", "--json", dir + "/x.json"},
+      120.0);
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
 }
 

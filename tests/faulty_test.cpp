@@ -49,9 +49,8 @@ TEST(FaultList, ParsesFaultsScenesAndSeconds) {
 }
 
 TEST(FaultList, RefusesWhatItCannotAct) {
-  for (const char* bad :
-       {"boom", "crash=", "sleep", "sleep:x", "sleep:-1", "sleep:1e9", "crash:2", ",", "nan,,flip",
-        "crash=torus/"})
+  for (const char* bad : {"boom", "crash=", "sleep", "sleep:x", "sleep:-1", "sleep:1e9", "crash:2",
+                          ",", "nan,,flip", "crash=torus/"})
     EXPECT_THROW(parse_faults(bad), std::invalid_argument) << bad;
   try {
     parse_faults("explode=torus");

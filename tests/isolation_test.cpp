@@ -60,9 +60,22 @@ test::ProcessResult conform(const std::string& json_path, const std::vector<std:
     setenv("FLATMARCH_FAULTY", faults, 1);
   else
     unsetenv("FLATMARCH_FAULTY");
-  std::vector<std::string> argv{self(), kCliFlag, "conform", "--backend", "faulty", "--backend",
-                                "scalar", "--size", "32x18", "--json", json_path,
-                                "--deadline-floor", "3", "--worker-memory", "2", "--gallery",
+  std::vector<std::string> argv{self(),
+                                kCliFlag,
+                                "conform",
+                                "--backend",
+                                "faulty",
+                                "--backend",
+                                "scalar",
+                                "--size",
+                                "32x18",
+                                "--json",
+                                json_path,
+                                "--deadline-floor",
+                                "3",
+                                "--worker-memory",
+                                "2",
+                                "--gallery",
                                 FLATMARCH_SOURCE_DIR "/scenes"};
   for (const char* scene : {"torus", "l_shape", "cube", "klein_bottle", "mirror_square"})
     argv.insert(argv.end(), {"--scene", scene});
@@ -123,9 +136,9 @@ TEST(IsolatedConform, ACrashAHangAndAnOutOfMemoryCostOnlyTheirOwnCases) {
 
 // `flatmarch conform` of the scalar backend over a few scenes, into `json_path`.
 std::vector<std::string> small_conform(const std::string& json_path) {
-  std::vector<std::string> argv{self(), kCliFlag, "conform", "--backend", "scalar", "--size",
-                                "32x18", "--json", json_path, "-q", "--gallery",
-                                FLATMARCH_SOURCE_DIR "/scenes"};
+  std::vector<std::string> argv{self(),    kCliFlag, "conform",   "--backend",
+                                "scalar",  "--size", "32x18",     "--json",
+                                json_path, "-q",     "--gallery", FLATMARCH_SOURCE_DIR "/scenes"};
   for (const char* scene : {"torus", "l_shape", "klein_bottle"})
     argv.insert(argv.end(), {"--scene", scene});
   return argv;
@@ -197,9 +210,22 @@ TEST(ResumedConform, RunsKilledAtRandomAndResumedEqualAnUninterruptedOne) {
 TEST(ResumedConform, AStoppedRunSaysHowToResume) {
   const std::string dir = test::make_temp_dir();
   setenv("FLATMARCH_FAULTY", "sleep:30=l_shape", 1);  // a case long enough to be stopped in
-  std::vector<std::string> argv{self(), kCliFlag, "conform", "--backend", "faulty", "--size",
-                                "32x18", "--json", dir + "/x.json", "--scene", "torus",
-                                "--scene", "l_shape", "--method", "analytic", "--gallery",
+  std::vector<std::string> argv{self(),
+                                kCliFlag,
+                                "conform",
+                                "--backend",
+                                "faulty",
+                                "--size",
+                                "32x18",
+                                "--json",
+                                dir + "/x.json",
+                                "--scene",
+                                "torus",
+                                "--scene",
+                                "l_shape",
+                                "--method",
+                                "analytic",
+                                "--gallery",
                                 FLATMARCH_SOURCE_DIR "/scenes"};
   // Started in the background: the test sends the signal.
   std::vector<char*> args;

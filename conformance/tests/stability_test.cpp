@@ -41,7 +41,8 @@ class Stability : public testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
     if (const BackendEntry* e = find_backend_entry(GetParam()); e && !e->wrong_on_purpose.empty())
-      GTEST_SKIP() << "the " << GetParam() << " backend is wrong on purpose: " << e->wrong_on_purpose;
+      GTEST_SKIP() << "the " << GetParam()
+                   << " backend is wrong on purpose: " << e->wrong_on_purpose;
     g_kernel = &test::backend_named(GetParam());
     if (const Availability a = g_kernel->availability(); !a.available)
       GTEST_SKIP() << "the " << GetParam() << " backend is unavailable here: " << a.reason;

@@ -9,19 +9,21 @@
 namespace flatmarch::test {
 namespace {
 
-constexpr std::array<std::pair<const char*, Fault::Kind>, 7> kKinds{{{"crash", Fault::Kind::crash},
-                                                                    {"abort", Fault::Kind::abort},
-                                                                    {"hang", Fault::Kind::hang},
-                                                                    {"oom", Fault::Kind::oom},
-                                                                    {"nan", Fault::Kind::nan},
-                                                                    {"flip", Fault::Kind::flip},
-                                                                    {"sleep", Fault::Kind::sleep}}};
+constexpr std::array<std::pair<const char*, Fault::Kind>, 7> kKinds{
+    {{"crash", Fault::Kind::crash},
+     {"abort", Fault::Kind::abort},
+     {"hang", Fault::Kind::hang},
+     {"oom", Fault::Kind::oom},
+     {"nan", Fault::Kind::nan},
+     {"flip", Fault::Kind::flip},
+     {"sleep", Fault::Kind::sleep}}};
 
 Fault parse_fault(const std::string& item) {
   const auto bad = [&](const std::string& why) {
-    return std::invalid_argument("FLATMARCH_FAULTY: '" + item + "': " + why +
-                                 " (FAULT[=SCENE[/METHOD]], FAULT one of crash, abort, hang, oom, nan, "
-                                 "flip, sleep:SECONDS)");
+    return std::invalid_argument(
+        "FLATMARCH_FAULTY: '" + item + "': " + why +
+        " (FAULT[=SCENE[/METHOD]], FAULT one of crash, abort, hang, oom, nan, "
+        "flip, sleep:SECONDS)");
   };
   Fault f;
   std::string kind = item;
@@ -72,7 +74,8 @@ std::vector<Fault> parse_faults(const std::string& text) {
   while (start <= text.size() && !text.empty()) {
     const size_t comma = std::min(text.find(',', start), text.size());
     const std::string item = text.substr(start, comma - start);
-    if (item.empty()) throw std::invalid_argument("FLATMARCH_FAULTY: an empty item in '" + text + "'");
+    if (item.empty())
+      throw std::invalid_argument("FLATMARCH_FAULTY: an empty item in '" + text + "'");
     faults.push_back(parse_fault(item));
     start = comma + 1;
   }

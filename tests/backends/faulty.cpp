@@ -10,13 +10,13 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
 #include <limits>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -44,7 +44,7 @@ constexpr size_t kMostBytes = size_t{1} << 40;
   constexpr size_t kBlock = size_t{64} << 20;
   static std::vector<std::unique_ptr<char[]>> blocks;
   for (size_t held = 0; held < kMostBytes; held += kBlock) {
-    blocks.emplace_back(new char[kBlock]);  // std::bad_alloc once the limit is reached
+    blocks.emplace_back(new char[kBlock]);        // std::bad_alloc once the limit is reached
     std::memset(blocks.back().get(), 1, kBlock);  // touched: resident, not only reserved
   }
   throw std::bad_alloc();
@@ -91,7 +91,8 @@ class FaultyBackend final : public Backend {
 
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override {
-    const std::optional<Fault> fault = fault_for(faults_from_environment(), scene.name, to_string(params.method));
+    const std::optional<Fault> fault =
+        fault_for(faults_from_environment(), scene.name, to_string(params.method));
     if (!fault) return blank(width, height);
     act(*fault);
     Frame f = scalar_.render(scene, camera, width, height, params, progress);
@@ -107,7 +108,8 @@ class FaultyBackend final : public Backend {
 
   Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
               int max_events) const override {
-    const std::optional<Fault> fault = fault_for(faults_from_environment(), scene.name, to_string(params.method));
+    const std::optional<Fault> fault =
+        fault_for(faults_from_environment(), scene.name, to_string(params.method));
     if (!fault) return {};
     act(*fault);
     Trace t = scalar_.trace(scene, ray, params, max_events);
