@@ -167,8 +167,9 @@ void add_conform(CLI::App& app) {
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
   cmd->add_option("--worker-memory", o->worker_memory_gib,
-                  "A worker's address-space limit in GiB (default: the machine's memory, or the "
-                  "cgroup's or this process's limit where lower)")
+                  "A worker's address-space limit in GiB (default: the machine's memory, or its "
+                  "cgroup's where lower, but at least 8, since drivers reserve more address space "
+                  "than they use; never above a limit this process has already)")
       ->check(CLI::Range(0.25, 65536.0));
   cmd->add_flag("--resume", o->resume,
                 "Finish a run that was stopped: the cases in the journal beside --json "

@@ -271,7 +271,7 @@ Interrupted::Interrupted(int sig)
                                                                             : "a signal")),
       signal(sig) {}
 
-StopSignals::StopSignals() : old_(new struct sigaction[2]) {
+StopSignals::StopSignals() {
   g_stop = 0;
   struct sigaction note {};
   note.sa_handler = note_stop;
@@ -284,7 +284,6 @@ StopSignals::StopSignals() : old_(new struct sigaction[2]) {
 StopSignals::~StopSignals() {
   ::sigaction(SIGINT, &old_[0], nullptr);
   ::sigaction(SIGTERM, &old_[1], nullptr);
-  delete[] old_;
 }
 
 int StopSignals::stop_requested() {

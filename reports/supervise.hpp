@@ -40,7 +40,7 @@ class StopSignals {
   static int stop_requested();
 
  private:
-  struct sigaction* old_;
+  struct sigaction old_[2] = {};  // SIGINT's and SIGTERM's handlers before
 };
 
 // The verdicts of a supervised case beside pass, limit and fail.
