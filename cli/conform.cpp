@@ -10,10 +10,10 @@
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
+#include "cli/supervised.hpp"
 #include "conformance/suite.hpp"
 #include "output/image_io.hpp"
 #include "reports/fingerprint.hpp"
-#include "reports/journal.hpp"
 #include "reports/shard.hpp"
 #include "reports/supervise.hpp"
 #include "scene/load.hpp"
@@ -63,33 +63,6 @@ std::string table_lines(const conformance::CaseResult& r) {
   return lines;
 }
 
-// The table's lines for a case that ended without a result: what ended it, and the end of what
-// its worker wrote on its standard error.
-std::string unfinished_lines(const std::string& key, const nlohmann::json& record) {
-  const std::string verdict = record.value("verdict", "error");
-  std::string what = verdict == reports::kVerdictCrash         ? "CRASH"
-                     : verdict == reports::kVerdictTimeout     ? "TIMEOUT"
-                     : verdict == reports::kVerdictOutOfMemory ? "OUT OF MEMORY"
-                                                               : "ERROR";
-  if (record.contains("signal_name")) what += " (" + record["signal_name"].get<std::string>() + ")";
-  if (record.contains("exit_code"))
-    what += " (exit " + std::to_string(record["exit_code"].get<int>()) + ")";
-  if (record.contains("error")) what += ": " + record["error"].get<std::string>();
-  char seconds[64];
-  std::snprintf(seconds, sizeof seconds, " after %.1f s", record.value("seconds", 0.0));
-  if (verdict != "error") what += seconds;
-  if (record.contains("deadline_seconds")) what += ", its deadline";
-  std::string lines = key + "  " + what + "\n";
-  // The last lines its worker wrote, indented.
-  std::vector<std::string> tail;
-  std::istringstream in(record.value("stderr_tail", ""));
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty()) tail.push_back(line);
-  for (size_t k = tail.size() > 6 ? tail.size() - 6 : 0; k < tail.size(); ++k)
-    lines += "    | " + tail[k] + "\n";
-  return lines;
-}
-
 }  // namespace
 
 void add_conform(CLI::App& app) {
@@ -120,10 +93,7 @@ void add_conform(CLI::App& app) {
     std::string shard;
     bool quiet = false;
     bool strict = false;
-    std::string isolate = "worker";
-    double deadline_scale = 10.0, deadline_floor = 30.0, worker_memory_gib = 0.0;
-    bool worker = false;
-    bool resume = false;
+    SupervisionOptions supervision;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("--backend", o->backends,
@@ -152,30 +122,7 @@ void add_conform(CLI::App& app) {
                   "I/N: run only shard I of N of the cases (split by their expected cost, the same "
                   "in every shard), for a scheduler to run the shards apart; `flatmarch merge` "
                   "puts their JSON back together");
-  cmd->add_option("--isolate", o->isolate,
-                  "worker: the cases run in a worker process, watched, so that a case that "
-                  "crashes, overruns its deadline or runs out of memory is recorded as crash, "
-                  "timeout or out_of_memory and a fresh worker goes on; none: in this process "
-                  "(for a debugger)")
-      ->check(CLI::IsMember({"worker", "none"}))
-      ->capture_default_str();
-  cmd->add_option("--deadline-scale", o->deadline_scale,
-                  "A case's deadline: this many times what the cost model expects of it ...")
-      ->check(CLI::Range(1.0, 1000.0))
-      ->capture_default_str();
-  cmd->add_option("--deadline-floor", o->deadline_floor, "... and at least this many seconds")
-      ->check(CLI::Range(0.1, 86400.0))
-      ->capture_default_str();
-  cmd->add_option("--worker-memory", o->worker_memory_gib,
-                  "A worker's address-space limit in GiB (default: the machine's memory, or its "
-                  "cgroup's where lower, but at least 8, since drivers reserve more address space "
-                  "than they use; never above a limit this process has already)")
-      ->check(CLI::Range(0.25, 65536.0));
-  cmd->add_flag("--resume", o->resume,
-                "Finish a run that was stopped: the cases in the journal beside --json "
-                "(JSON.journal, each case appended as it finishes) are kept, the others run; the "
-                "same command line otherwise");
-  cmd->add_flag("--worker", o->worker)->group("");  // a worker of a supervised run (hidden)
+  add_supervision_options(*cmd, o->supervision, "beside --json: JSON.journal");
   cmd->add_flag("-q,--quiet", o->quiet, "Only the summary line");
   cmd->add_flag("--strict", o->strict,
                 "Exit 1 when a case is at its method's limit too, not only when one fails");
@@ -243,7 +190,7 @@ void add_conform(CLI::App& app) {
           std::find(precisions.begin(), precisions.end(), o->params.precision) == precisions.end())
         skip = "does not march in " + o->precision;
       if (!skip.empty()) {
-        if (!o->worker) std::printf("%-8s skipped: %s\n", name.c_str(), skip.c_str());
+        if (!o->supervision.worker) std::printf("%-8s skipped: %s\n", name.c_str(), skip.c_str());
         out["skipped"].push_back({{"backend", name}, {"reason", skip}});
         continue;
       }
@@ -307,7 +254,7 @@ void add_conform(CLI::App& app) {
       }
       return record;
     };
-    if (o->worker) {
+    if (o->supervision.worker) {
       reports::serve_cases([&](const std::string& key) {
         for (const Case& c : held)
           if (c.key == key) return run_case(c);
@@ -319,96 +266,48 @@ void add_conform(CLI::App& app) {
       std::printf("%-8s %-30s %-9s %7s %8s %8s %7s %7s %6s  %-24s %s\n", "backend", "scene",
                   "method", "ambig%", "hit%", "cross%", "img%", "stepKS", "traces", "failures",
                   "verdict");
-    // The journal beside the output: a new one, or the stopped run's to resume.
-    std::vector<std::string> keys;
-    for (const Case& c : held) keys.push_back(c.key);
-    nlohmann::json options = out["options"];
-    if (shard) options["shard"] = plan.record;
-    const nlohmann::json header =
-        reports::journal_header("conform", out["fingerprint"], options, keys);
-    std::map<std::string, nlohmann::json> records;
-    std::optional<reports::Journal> journal;
-    try {
-      const fs::path path = o->json + ".journal";
-      journal.emplace(o->resume ? reports::Journal::resume(path, header, records)
-                                : reports::Journal::start(path, header));
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string(o->resume ? "--resume: " : "") + e.what());
+    SupervisedRun supervised{.command = "conform",
+                             .journal = o->json + ".journal",
+                             .fingerprint = out["fingerprint"],
+                             .options = out["options"],
+                             .cases = {},
+                             .quiet = o->quiet};
+    if (shard) supervised.options["shard"] = plan.record;
+    std::map<std::string, const Case*> by_key;
+    for (const Case& c : held) {
+      supervised.cases.push_back({c.key, c.cost});
+      by_key[c.key] = &c;
     }
-    if (o->resume && !o->quiet)
-      std::fprintf(stderr, "conform: resuming %s: %zu of %zu cases done\n", journal->path().c_str(),
-                   records.size(), held.size());
     int unfinished = 0;
-    const auto show = [&](const Case& c, const nlohmann::json& record) {
+    const auto show = [&](const std::string& key, const nlohmann::json& record) {
       if (shard && !o->quiet)
         std::fprintf(stderr, "conform: shard %s: case %d of %zu\n", shard->text().c_str(),
                      cases + 1, out["shard"]["holds"].size());
       ++cases;
-      const std::string verdict = record.contains("error") ? "error" : record.value("verdict", "");
+      const std::string verdict = record_verdict(record);
       failed += verdict == "fail";
       limits += verdict == "limit";
       const bool finished = verdict == "pass" || verdict == "limit" || verdict == "fail";
       unfinished += !finished;
       if (o->quiet) return;
       std::fputs(
-          finished ? record.value("table", "").c_str() : unfinished_lines(c.key, record).c_str(),
+          finished ? record.value("table", "").c_str() : unfinished_lines(key, record).c_str(),
           stdout);
       std::fflush(stdout);
     };
-    // A case finished (here, by a worker, or by a supervisor that saw it fail): journaled, shown.
-    const auto take = [&](const Case& c, nlohmann::json record) {
+    std::optional<reports::Journal> journal;
+    const std::map<std::string, nlohmann::json> records = run_supervised(
+        supervised, o->supervision,
+        [&](const std::string& key) { return run_case(*by_key.at(key)); }, show, journal);
+    for (const Case& c : held) {
+      nlohmann::json record = records.at(c.key);
+      record.erase("table");
+      // A case its worker failed: the supervisor's record, named.
       if (!record.contains("backend")) {
         record["backend"] = c.backend->name();
         record["scene"] = c.scene->name;
         record["method"] = to_string(c.method);
       }
-      journal->append(c.key, record);
-      show(c, record);
-      records[c.key] = std::move(record);
-    };
-    std::vector<const Case*> to_run;
-    for (const Case& c : held) {
-      if (const auto it = records.find(c.key); it != records.end())
-        show(c, it->second);
-      else
-        to_run.push_back(&c);
-    }
-    const std::string resume_hint = "flatmarch " + quoted_command_line("--resume");
-    try {
-      const reports::StopSignals stop;
-      if (o->isolate == "none") {
-        for (const Case* c : to_run) {
-          if (const int sig = reports::StopSignals::stop_requested())
-            throw reports::Interrupted(sig);
-          take(*c, run_case(*c));
-        }
-      } else {
-        reports::WorkerOptions workers;
-        workers.argv = worker_command();
-        workers.memory_bytes = o->worker_memory_gib > 0.0
-                                   ? o->worker_memory_gib * 1024.0 * 1024.0 * 1024.0
-                                   : std::max(memory_limit().bytes, 8.0 * 1024 * 1024 * 1024);
-        std::vector<reports::SupervisedCase> supervised;
-        for (const Case* c : to_run)
-          supervised.push_back(
-              {c->key, reports::case_deadline(c->cost, o->deadline_scale, o->deadline_floor)});
-        size_t next = 0;
-        reports::supervise(workers, supervised,
-                           [&](const std::string&, const nlohmann::json& record) {
-                             take(*to_run[next++], record);
-                           });
-      }
-    } catch (const reports::Interrupted& e) {
-      std::fprintf(stderr,
-                   "conform: %s after %zu of %zu cases; the journal %s keeps them: resume with\n"
-                   "  %s\n",
-                   e.what(), records.size(), held.size(), journal->path().c_str(),
-                   resume_hint.c_str());
-      throw;
-    }
-    for (const Case& c : held) {
-      nlohmann::json record = records.at(c.key);
-      record.erase("table");
       out["cases"].push_back(std::move(record));
     }
     if (!no_images.empty())

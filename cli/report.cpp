@@ -5,12 +5,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
+#include "cli/supervised.hpp"
+#include "conformance/suite.hpp"
 #include "reports/fingerprint.hpp"
 #include "reports/report.hpp"
+#include "reports/supervise.hpp"
 #include "reports/surfaces.hpp"
 #include "scene/load.hpp"
 
@@ -150,6 +154,7 @@ void add_report(CLI::App& app) {
     bool full = false, no_sweep = false, no_scaling = false, no_html = false, quiet = false;
     MarchParams params;
     BackendOptions backend_options;
+    SupervisionOptions supervision;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("RESULTS", o->results,
@@ -173,7 +178,9 @@ void add_report(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--repetitions", o->repetitions,
                   "Timed repetitions per case (default 3; --full 5)");
-  cmd->add_option("--min-time", o->min_time, "Seconds per repetition, at least one frame")
+  cmd->add_option("--min-time", o->min_time,
+                  "Seconds per repetition of a timed case (the matrix's and the scaling series'), "
+                  "at least one frame")
       ->capture_default_str();
   cmd->add_option("--sweep-backend", o->sweep_backend,
                   "Backend of the sweep (default scalar: the only one with f64)");
@@ -204,8 +211,11 @@ void add_report(CLI::App& app) {
       *cmd, o->params,
       {.eps = true, .offset = true, .max_steps = true, .max_distance = false, .omega = false});
   add_backend_options(*cmd, o->backend_options);
+  add_supervision_options(*cmd, o->supervision, "OUT/results.json.journal");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
+    if (o->supervision.resume && !o->results.empty())
+      throw UsageError("--resume finishes a measuring run: give no RESULTS with it");
     if (!o->shard.empty() && (!o->results.empty() || !o->baseline.empty() ||
                               !o->write_baseline.empty() || !o->previous.empty()))
       throw UsageError(
@@ -284,6 +294,7 @@ void add_report(CLI::App& app) {
     r.scaling_enabled = !o->no_scaling;
     r.scaling.methods = r.matrix.methods;
     r.scaling.backend_options = o->backend_options;
+    r.scaling.min_time = o->min_time;
     for (const Scene& s : scenes)
       if (s.name == "torus") r.scaling.resolution_scene = s;
     if (o->full) {
@@ -299,9 +310,105 @@ void add_report(CLI::App& app) {
 
     if (!o->shard.empty()) r.shard = parse_shard_option(o->shard);
 
+    // The run's cases (a shard's), each run in a worker (or here, --isolate none), journaled.
+    const std::vector<std::pair<std::string, double>> all = reports::report_cases(scenes, r);
+    std::optional<reports::ShardPlan> plan;
+    if (r.shard) plan = reports::plan_shard(*r.shard, all);
+    json results = reports::report_header(scenes, r);
+    reports::add_to_benchmark_context(results["fingerprint"]);
+    std::optional<reports::MatrixBackends> backends;  // made once, where cases run
+    conformance::Suite matrix_suite, sweep_suite;
+    // One case here: the part of the results it measures.
+    const auto run_case = [&](const std::string& key) -> json {
+      if (!backends) backends = reports::matrix_backends(r.matrix);
+      try {
+        return reports::run_report_part(
+            scenes, r, [&](const std::string& k) { return k == key; }, {matrix_suite, sweep_suite},
+            nullptr, &*backends, /*every_stage=*/false);
+      } catch (const std::bad_alloc&) {
+        throw;  // a worker answers out_of_memory
+      } catch (const std::exception& e) {
+        return {{"error", e.what()}};
+      }
+    };
+    if (o->supervision.worker) {
+      reports::serve_cases(run_case);
+      return;
+    }
+    if (plan) std::fprintf(stderr, "report: %s\n", plan->summary.c_str());
+    {
+      std::error_code error;
+      fs::create_directories(o->out, error);
+      if (error) throw UsageError("-o: cannot create " + o->out + ": " + error.message());
+    }
+    SupervisedRun run{.command = "report",
+                      .journal = fs::path(o->out) / "results.json.journal",
+                      .fingerprint = results["fingerprint"],
+                      .options = results["options"],
+                      .cases = {},
+                      .quiet = o->quiet};
+    run.options["min_time"] = r.matrix.min_time;
+    run.options["images"] = !r.matrix.images.empty();
+    run.options["sweep"] = {
+        {"backend", r.sweep.backend},
+        {"size", std::to_string(r.sweep.width) + "x" + std::to_string(r.sweep.height)},
+        {"repetitions", r.sweep.repetitions}};
+    if (plan) run.options["shard"] = plan->record;
+    std::map<std::string, int> stage_total, stage_done;
+    for (const auto& [key, cost] : all)
+      if (!plan || plan->holds(key)) {
+        run.cases.push_back({key, cost});
+        ++stage_total[key.substr(0, key.find('/'))];
+      }
     StageProgress progress{o->quiet, "", nullptr};
-    json results = reports::run_report(scenes, r, std::ref(progress));
+    for (const json& skip : reports::matrix_backends(r.matrix).skipped)
+      if (!o->quiet)
+        std::fprintf(stderr, "report: %s skipped: %s\n", skip["backend"].get<std::string>().c_str(),
+                     skip["reason"].get<std::string>().c_str());
+    int unfinished = 0;
+    const auto show = [&](const std::string& key, const json& record) {
+      const std::string stage = key.substr(0, key.find('/'));
+      const bool finished = !record.contains("verdict") && !record.contains("error");
+      if (!finished) {
+        ++unfinished;
+        if (progress.reporter) progress.reporter->done();
+        progress.reporter.reset();
+        progress.stage.clear();
+        std::fputs(("report: " + unfinished_lines(key, record)).c_str(), stderr);
+      }
+      progress(stage, key, ++stage_done[stage], stage_total[stage]);
+    };
+    std::optional<reports::Journal> journal;
+    const std::map<std::string, json> records =
+        run_supervised(run, o->supervision, run_case, show, journal);
     if (progress.reporter) progress.reporter->done();
+    // The parts put together in the run's order; a case that did not finish in its place.
+    std::vector<std::string> keys;
+    std::vector<json> made;  // the unfinished matrix cases' parts
+    made.reserve(run.cases.size());
+    std::vector<std::pair<std::string, const json*>> parts;
+    results["unfinished"] = json::array();
+    for (const RunCase& c : run.cases) {
+      keys.push_back(c.key);
+      const json& record = records.at(c.key);
+      if (!record.contains("verdict") && !record.contains("error")) {
+        parts.emplace_back(c.key, &record);
+        continue;
+      }
+      results["unfinished"].push_back(reports::unfinished_entry(c.key, record));
+      if (json part = reports::unfinished_part(c.key, record, scenes, r); !part.is_null()) {
+        made.push_back(std::move(part));
+        parts.emplace_back(c.key, &made.back());
+      }
+    }
+    results.update(reports::assemble_report(results, parts, keys));
+    if (r.shard) {
+      results["shard"] = plan->record;
+      if (!r.matrix.images.empty())
+        reports::draw_oracle_images(scenes, r.matrix, results["matrix"]);
+    } else {
+      reports::finish_report(results, scenes, r);
+    }
     if (!no_images.empty())
       results["left_out"] = {
           {"what", o->no_html ? json::array({"image.perceptual_failpercent"})
@@ -321,10 +428,21 @@ void add_report(CLI::App& app) {
                                          " -o DIR/results.json` draws the recommended gallery "
                                          "and the page from these results"));
     };
+    // The cases that did not finish, again at the end, where a person reads.
+    const auto say_unfinished = [&] {
+      if (results["unfinished"].empty()) return;
+      std::printf("report: %zu cases did not finish (the page's failure list has them):\n",
+                  results["unfinished"].size());
+      for (const json& u : results["unfinished"])
+        std::printf("  %s  %s\n", u["key"].get<std::string>().c_str(),
+                    u["error"].get<std::string>().c_str());
+    };
     if (r.shard) {
       const fs::path file = fs::path(o->out) / "results.json";
       write_json(file, results);
+      journal->complete();
       say(file);
+      say_unfinished();
       std::printf(
           "report: shard %s: wrote %s; put the shards together with `flatmarch merge "
           "SHARD.../results.json -o OUT/results.json`\n",
@@ -334,7 +452,9 @@ void add_report(CLI::App& app) {
     results["regression"] = regression_section(results, o->baseline);
     const fs::path file = fs::path(o->out) / "results.json";
     write_json(file, results);
+    journal->complete();
     std::printf("%s", reports::describe_selection(results, "").c_str());
+    say_unfinished();
     std::printf("report: wrote %s\n", file.c_str());
     say(file);
     if (!o->write_baseline.empty()) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <numeric>
+#include <optional>
 #include <regex>
 #include <sstream>
 
@@ -312,11 +313,8 @@ std::string matrix_case_key(const std::string& backend, const std::string& metho
   return "matrix/" + backend + "/" + method + "/" + scene;
 }
 
-namespace {
-
-// The backends of the matrix that can run here, and the reason each other is skipped.
-std::vector<std::unique_ptr<Backend>> matrix_backends(const MatrixOptions& o, json* skipped) {
-  std::vector<std::unique_ptr<Backend>> backends;
+MatrixBackends matrix_backends(const MatrixOptions& o) {
+  MatrixBackends out;
   for (const std::string& name : o.backends) {
     std::unique_ptr<Backend> b = make_backend(name, o.backend_options);
     if (!b) throw std::invalid_argument("unknown backend \"" + name + "\"");
@@ -326,20 +324,18 @@ std::vector<std::unique_ptr<Backend>> matrix_backends(const MatrixOptions& o, js
     if (skip.empty() && std::find(p.begin(), p.end(), o.params.precision) == p.end())
       skip = "does not march in this precision";
     if (!skip.empty()) {
-      if (skipped) skipped->push_back({{"backend", name}, {"reason", skip}});
+      out.skipped.push_back({{"backend", name}, {"reason", skip}});
       continue;
     }
-    backends.push_back(std::move(b));
+    out.available.push_back(std::move(b));
   }
-  return backends;
+  return out;
 }
-
-}  // namespace
 
 std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
                                                          const MatrixOptions& o) {
   std::vector<std::pair<std::string, double>> cases;
-  for (const auto& backend : matrix_backends(o, nullptr))
+  for (const auto& backend : matrix_backends(o).available)
     for (const Scene& scene : scenes)
       for (const Method m : o.methods) {
         const std::string method = to_string(m);
@@ -356,9 +352,12 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
 }
 
 json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, conformance::Suite& suite,
-                const MatrixProgress& progress) {
-  json out = {{"cases", json::array()}, {"skipped", json::array()}};
-  const std::vector<std::unique_ptr<Backend>> backends = matrix_backends(o, &out["skipped"]);
+                const MatrixProgress& progress, const MatrixBackends* built) {
+  std::optional<MatrixBackends> own;
+  if (!built) own = matrix_backends(o);
+  const MatrixBackends& made = built ? *built : *own;
+  const std::vector<std::unique_ptr<Backend>>& backends = made.available;
+  json out = {{"cases", json::array()}, {"skipped", made.skipped}};
   for (const json& skip : out["skipped"])
     if (progress)
       progress(
@@ -428,21 +427,6 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
     }
   }
   for (const std::string& name : order) out["cases"].push_back(cases[name]);
-  // The truth beside them.
-  if (!o.images.empty())
-    if (const Backend* oracle = find_backend("oracle"))
-      for (const Scene& scene : scenes) {
-        // A shard draws the truth of its own scenes.
-        if (std::none_of(order.begin(), order.end(), [&](const std::string& name) {
-              return cases[name]["scene"] == scene.name;
-            }))
-          continue;
-        MarchParams params = o.params;
-        params.method = Method::oracle;
-        const std::filesystem::path png = o.images / "oracle" / (scene.name + ".png");
-        std::filesystem::create_directories(png.parent_path());
-        write_png(oracle->render(scene, scene.camera, o.width, o.height, params, {}), png);
-      }
   for (const auto& [name, frame] : frames) {
     if (frame.width == 0) continue;
     const json& c = cases[name];
@@ -452,6 +436,24 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
     write_png(frame, png);
   }
   return out;
+}
+
+void draw_oracle_images(const std::vector<Scene>& scenes, const MatrixOptions& o,
+                        const json& matrix) {
+  const Backend* oracle = find_backend("oracle");
+  if (o.images.empty() || !oracle) return;
+  for (const Scene& scene : scenes) {
+    // A shard draws the truth of its own scenes.
+    const json& cases = matrix.at("cases");
+    if (std::none_of(cases.begin(), cases.end(),
+                     [&](const json& c) { return c.value("scene", "") == scene.name; }))
+      continue;
+    MarchParams params = o.params;
+    params.method = Method::oracle;
+    const std::filesystem::path png = o.images / "oracle" / (scene.name + ".png");
+    std::filesystem::create_directories(png.parent_path());
+    write_png(oracle->render(scene, scene.camera, o.width, o.height, params, {}), png);
+  }
 }
 
 }  // namespace flatmarch::reports

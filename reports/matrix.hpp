@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -60,12 +61,27 @@ nlohmann::json device_json(const DeviceInfo& device);
 // The same in one line, as benchmark runs are labelled: "device NAME; driver DRIVER; software".
 std::string device_label(const DeviceInfo& device);
 
-// Runs the matrix. Returns {"benchmarks": Google Benchmark's JSON document (each GPU case's run
-// labelled with its device), "cases": one per backend x scene x method with its timing (median
-// and samples, ms), counters, accuracy and, for a GPU backend, the device it ran on (device_json),
-// "skipped": backends unavailable here with the reason}.
+// The matrix's backends that can run here, made once (a worker of a supervised report runs case
+// after case on them), and "skipped": the others, each {"backend", "reason"}.
+struct MatrixBackends {
+  std::vector<std::unique_ptr<Backend>> available;
+  nlohmann::json skipped = nlohmann::json::array();
+};
+MatrixBackends matrix_backends(const MatrixOptions& options);
+
+// Runs the matrix (on `backends`, or on matrix_backends(options) where null). Returns
+// {"benchmarks": Google Benchmark's JSON document (each GPU case's run labelled with its device),
+// "cases": one per backend x scene x method with its timing (median and samples, ms), counters,
+// accuracy and, for a GPU backend, the device it ran on (device_json), "skipped": backends
+// unavailable here with the reason}.
 nlohmann::json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& options,
-                          conformance::Suite& suite, const MatrixProgress& progress);
+                          conformance::Suite& suite, const MatrixProgress& progress,
+                          const MatrixBackends* backends = nullptr);
+
+// The oracle's frame of each scene the `matrix` (run_matrix's) has a case of, beside the
+// backends' frames: options.images/oracle/SCENE.png. Nothing where options.images is empty.
+void draw_oracle_images(const std::vector<Scene>& scenes, const MatrixOptions& options,
+                        const nlohmann::json& matrix);
 
 // Runs Google Benchmark on what is registered now, collecting its JSON (with the context, where
 // the fingerprint is added) and calling `on_run` with each run's name as it ends; clears the

@@ -6,10 +6,12 @@
 #include <cstdio>
 #include <ctime>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "reports/fingerprint.hpp"
 #include "reports/gallery.hpp"
+#include "reports/supervise.hpp"
 #include "reports/surfaces.hpp"
 
 namespace flatmarch::reports {
@@ -56,19 +58,9 @@ std::vector<std::pair<std::string, double>> report_cases(const std::vector<Scene
   return cases;
 }
 
-json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
-                const ReportProgress& progress) {
-  ReportOptions o = options;
-  json shard;
-  if (o.shard) {
-    ShardPlan plan = plan_shard(*o.shard, report_cases(scenes, o));
-    shard = std::move(plan.record);
-    o.matrix.holds = o.sweep.holds = o.scaling.holds = plan.holds;
-    if (progress) progress("shard", plan.summary, 0, 0);
-  }
+json report_header(const std::vector<Scene>& scenes, const ReportOptions& o) {
   json results = {{"format", "flatmarch-report/1"}, {"created", now_utc()}};
   results["fingerprint"] = hardware_fingerprint();
-  add_to_benchmark_context(results["fingerprint"]);
   // The lists make_report.py draws by (it restates none).
   json methods = json::array();
   for (Method m : kKernelMethods) methods.push_back(to_string(m));
@@ -88,7 +80,19 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
       {"methods", json::array()}};
   for (const Scene& s : scenes) results["options"]["scenes"].push_back(s.name);
   for (Method m : o.matrix.methods) results["options"]["methods"].push_back(to_string(m));
-  conformance::Suite suite;
+  return results;
+}
+
+json run_report_part(const std::vector<Scene>& scenes, const ReportOptions& o,
+                     const std::function<bool(const std::string& key)>& holds,
+                     const ReportSuites& suites, const ReportProgress& progress,
+                     const MatrixBackends* backends, bool every_stage) {
+  // Whether the part holds a case of a stage: a stage it holds none of is left out of it, but
+  // for a shard's results (every_stage), whose every enabled stage is there, if empty.
+  const auto holds_any = [&](const std::vector<std::pair<std::string, double>>& cases) {
+    return every_stage || std::any_of(cases.begin(), cases.end(),
+                                      [&](const auto& c) { return !holds || holds(c.first); });
+  };
   auto started = std::chrono::steady_clock::now();
   // Seconds since the last call: the time each stage took.
   const auto lap = [&started] {
@@ -97,37 +101,113 @@ json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
     started = now;
     return s;
   };
-  results["seconds"] = json::object();
-  results["matrix"] =
-      run_matrix(scenes, o.matrix, suite, [&](const std::string& line, int done, int total) {
-        if (progress) progress("matrix", line, done, total);
-      });
-  results["seconds"]["matrix"] = lap();
-  if (o.sweep_enabled)
-    results["sweep"] = run_sweep(sweep_scenes(scenes, o), o.sweep, suite,
-                                 [&](const std::string& line, int done, int total) {
-                                   if (progress) progress("sweep", line, done, total);
-                                 });
-  results["seconds"]["sweep"] = lap();
-  if (o.scaling_enabled)
-    results["scaling"] = run_scaling(o.scaling, [&](const std::string& line, int done, int total) {
+  json part = {{"seconds", json::object()}};
+  MatrixOptions matrix = o.matrix;
+  matrix.holds = holds;
+  if (holds_any(matrix_cases(scenes, o.matrix))) {
+    part["matrix"] = run_matrix(
+        scenes, matrix, suites.matrix,
+        [&](const std::string& line, int done, int total) {
+          if (progress) progress("matrix", line, done, total);
+        },
+        backends);
+    part["seconds"]["matrix"] = lap();
+  }
+  const std::vector<Scene> swept = sweep_scenes(scenes, o);
+  if (o.sweep_enabled && holds_any(sweep_cases(swept, o.sweep))) {
+    SweepOptions sweep = o.sweep;
+    sweep.holds = holds;
+    part["sweep"] =
+        run_sweep(swept, sweep, suites.sweep, [&](const std::string& line, int done, int total) {
+          if (progress) progress("sweep", line, done, total);
+        });
+    part["seconds"]["sweep"] = lap();
+  }
+  if (o.scaling_enabled && holds_any(scaling_cases(o.scaling))) {
+    ScalingOptions scaling = o.scaling;
+    scaling.holds = holds;
+    part["scaling"] = run_scaling(scaling, [&](const std::string& line, int done, int total) {
       if (progress) progress("scaling", line, done, total);
     });
-  results["seconds"]["scaling"] = lap();
-  if (o.shard) {
-    results["shard"] = shard;
-    return results;
+    part["seconds"]["scaling"] = lap();
   }
+  return part;
+}
+
+json unfinished_entry(const std::string& key, const json& record) {
+  json entry = {{"key", key},
+                {"stage", key.substr(0, key.find('/'))},
+                {"verdict", record.value("verdict", "error")},
+                {"error", unfinished_summary(record)}};
+  for (const char* field :
+       {"seconds", "signal_name", "exit_code", "deadline_seconds", "stderr_tail", "signal"})
+    if (record.contains(field)) entry[field] = record[field];
+  return entry;
+}
+
+json unfinished_part(const std::string& key, const json& record, const std::vector<Scene>& scenes,
+                     const ReportOptions& o) {
+  // matrix/BACKEND/METHOD/SCENE
+  const size_t a = key.find('/'), b = key.find('/', a + 1), c = key.find('/', b + 1);
+  if (key.compare(0, a, "matrix") != 0 || b == std::string::npos || c == std::string::npos)
+    return nullptr;
+  const std::string backend = key.substr(a + 1, b - a - 1), method = key.substr(b + 1, c - b - 1),
+                    scene_name = key.substr(c + 1);
+  const auto scene = std::find_if(scenes.begin(), scenes.end(),
+                                  [&](const Scene& s) { return s.name == scene_name; });
+  const std::optional<Method> m = parse_method(method);
+  if (scene == scenes.end() || !m) return nullptr;
+  json entry = {{"name", case_name(backend, *m, scene_name, o.matrix.width, o.matrix.height)},
+                {"backend", backend},
+                {"scene", scene_name},
+                {"surface_type", surface_type(*scene)},
+                {"method", method},
+                {"width", o.matrix.width},
+                {"height", o.matrix.height},
+                {"verdict", record.value("verdict", "error")},
+                {"error", unfinished_summary(record)}};
+  return {{"matrix", {{"cases", json::array({entry})}}}};
+}
+
+void finish_report(json& results, const std::vector<Scene>& scenes, const ReportOptions& o) {
+  const auto started = std::chrono::steady_clock::now();
   results["ranking"] = rank_backends(results["matrix"]);
   results["recommendation"] = recommend(results["ranking"], results.value("sweep", json::object()));
-  if (!o.matrix.images.empty())
+  if (!o.matrix.images.empty()) {
+    draw_oracle_images(scenes, o.matrix, results["matrix"]);
     results["gallery"] = recommended_gallery(scenes, results["recommendation"],
                                              {.width = o.matrix.width,
                                               .height = o.matrix.height,
                                               .params = o.matrix.params,
                                               .backend_options = o.matrix.backend_options,
                                               .images = o.matrix.images});
-  results["seconds"]["gallery"] = lap();
+  }
+  results["seconds"]["gallery"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
+                const ReportProgress& progress) {
+  ReportOptions o = options;
+  json shard;
+  std::function<bool(const std::string&)> holds;
+  if (o.shard) {
+    ShardPlan plan = plan_shard(*o.shard, report_cases(scenes, o));
+    shard = std::move(plan.record);
+    holds = plan.holds;
+    if (progress) progress("shard", plan.summary, 0, 0);
+  }
+  json results = report_header(scenes, o);
+  add_to_benchmark_context(results["fingerprint"]);
+  conformance::Suite suite;
+  results.update(
+      run_report_part(scenes, o, holds, {suite, suite}, progress, nullptr, /*every_stage=*/true));
+  if (o.shard) {
+    if (!o.matrix.images.empty()) draw_oracle_images(scenes, o.matrix, results["matrix"]);
+    results["shard"] = shard;
+    return results;
+  }
+  finish_report(results, scenes, o);
   return results;
 }
 
@@ -506,8 +586,19 @@ json check_baseline(const json& baseline, const json& results) {
     }
     const json& c = *it->second;
     if (c.contains("error")) {
-      out["regressions"].push_back(
-          {{"case", name}, {"figure", "error"}, {"now", c["error"]}, {"was", "ran"}});
+      // A case that crashed, overran its deadline or ran out of memory (a supervised run's
+      // verdicts), or that could not run: a regression of a case that ran before.
+      const std::string was =
+          figures.value("verdict", figures.value("passed", false) ? "pass" : "fail");
+      if (c.contains("verdict"))
+        out["regressions"].push_back({{"case", name},
+                                      {"figure", "verdict"},
+                                      {"was", was},
+                                      {"now", c["verdict"]},
+                                      {"error", c["error"]}});
+      else
+        out["regressions"].push_back(
+            {{"case", name}, {"figure", "error"}, {"now", c["error"]}, {"was", "ran"}});
       continue;
     }
     ++compared;
@@ -605,85 +696,117 @@ std::string describe_gate(const json& check, const json& baseline,
   return out;
 }
 
+std::vector<std::string> report_part_keys(const json& part) {
+  std::vector<std::string> keys;
+  if (part.contains("matrix"))
+    for (const json& c : part["matrix"].at("cases"))
+      keys.push_back(matrix_case_key(c["backend"], c["method"], c["scene"]));
+  if (part.contains("sweep"))
+    for (const json& p : part["sweep"].at("points")) {
+      std::string key = sweep_case_key(p["surface_type"], p["method"]);
+      if (keys.empty() || keys.back() != key) keys.push_back(std::move(key));
+    }
+  if (part.contains("scaling"))
+    for (const json& s : part["scaling"].at("series"))
+      keys.push_back(scaling_case_key(s["family"], s["backend"], s["method"]));
+  return keys;
+}
+
+json assemble_report(const json& header,
+                     const std::vector<std::pair<std::string, const json*>>& parts,
+                     const std::vector<std::string>& keys) {
+  std::map<std::string, size_t> position;  // of each case in the run's list
+  for (size_t k = 0; k < keys.size(); ++k) position[keys[k]] = k;
+  std::map<std::string, json> matrix;  // case key -> case
+  json benchmarks = json::array(), context = json::object(), scaling_benchmarks = json::array();
+  json points = json::array(), confirmations = json::array(), series = json::array();
+  json sweep_options, seconds = json::object();
+  json matrix_skipped = json::array(), scaling_skipped;
+  bool matrix_seen = false;
+  std::string sweep_from;
+  for (const auto& [label, doc] : parts) {
+    if (doc->contains("matrix")) {
+      if (!matrix_seen) matrix_skipped = (*doc)["matrix"].value("skipped", json::array());
+      matrix_seen = true;
+      for (const json& c : (*doc)["matrix"].at("cases"))
+        matrix[matrix_case_key(c["backend"], c["method"], c["scene"])] = c;
+      const json& timed = (*doc)["matrix"].value("benchmarks", json::object());
+      for (const json& run : timed.value("benchmarks", json::array())) benchmarks.push_back(run);
+      if (context.empty()) context = timed.value("context", json::object());
+    }
+    if (doc->contains("sweep")) {
+      const json& sweep = (*doc)["sweep"];
+      if (sweep_options.is_null()) {
+        sweep_options = sweep["options"];
+        sweep_from = label;
+      }
+      if (sweep["options"] != sweep_options)
+        throw std::invalid_argument(label + ": its sweep's options differ from " + sweep_from +
+                                    "'s: not a part of the same run");
+      for (const json& p : sweep["points"]) points.push_back(p);
+      for (const json& k : sweep["confirmations"]) confirmations.push_back(k);
+    }
+    if (doc->contains("scaling")) {
+      if (scaling_skipped.is_null()) scaling_skipped = (*doc)["scaling"]["skipped"];
+      for (const json& s : (*doc)["scaling"]["series"]) series.push_back(s);
+      const json& runs = (*doc)["scaling"].value("benchmarks", json::object());
+      for (const json& run : runs.value("benchmarks", json::array()))
+        scaling_benchmarks.push_back(run);
+      if (context.empty()) context = runs.value("context", json::object());
+    }
+    const json stages = doc->value("seconds", json::object());
+    for (const auto& [stage, s] : stages.items())
+      seconds[stage] = seconds.value(stage, 0.0) + s.get<double>();
+  }
+  json out = {{"seconds", seconds}};
+  out["matrix"] = {{"cases", json::array()},
+                   {"skipped", matrix_skipped},
+                   {"benchmarks", {{"context", context}, {"benchmarks", benchmarks}}}};
+  for (const std::string& key : keys)
+    if (matrix.count(key)) out["matrix"]["cases"].push_back(matrix[key]);
+  if (!sweep_options.is_null())
+    out["sweep"] = merged_sweep(sweep_options, std::move(points), std::move(confirmations),
+                                header["options"]["scenes"],
+                                sweep_options.value("methods", header["registry"]["methods"]));
+  if (!scaling_skipped.is_null()) {
+    const auto at = [&](const json& s) {
+      const auto it = position.find(scaling_case_key(s["family"], s["backend"], s["method"]));
+      return it == position.end() ? keys.size() : it->second;
+    };
+    std::stable_sort(series.begin(), series.end(),
+                     [&](const json& a, const json& b) { return at(a) < at(b); });
+    out["scaling"] = {{"series", series},
+                      {"skipped", scaling_skipped},
+                      {"benchmarks", {{"context", context}, {"benchmarks", scaling_benchmarks}}}};
+  }
+  return out;
+}
+
 json merge_report(const std::vector<std::pair<std::string, json>>& files) {
   const std::vector<const std::pair<std::string, json>*> shards =
       check_shards(files, "flatmarch-report/1", "flatmarch report");
   const json& first = files.front().second;
-  const json& list = first["shard"]["cases"];
-  std::map<std::string, size_t> position;  // of each case in the run's list
-  for (size_t k = 0; k < list.size(); ++k) position[list[k].get<std::string>()] = k;
-
-  std::map<std::string, json> matrix;  // case key -> case
-  json benchmarks = json::array(), context = json::object(), scaling_benchmarks = json::array();
-  json points = json::array(), confirmations = json::array(), series = json::array();
-  json sweep_options, seconds = json::object(), per_shard = json::array();
+  std::vector<std::string> keys;
+  for (const json& key : first["shard"]["cases"]) keys.push_back(key.get<std::string>());
+  std::vector<std::pair<std::string, const json*>> parts;
+  json per_shard = json::array();
   for (const auto* entry : shards) {
     const auto& [file, doc] = *entry;
     ShardContents contents(file, doc["shard"]);
-    for (const json& c : doc.at("matrix").at("cases")) {
-      const std::string key = matrix_case_key(c["backend"], c["method"], c["scene"]);
-      contents.add(key);
-      matrix[key] = c;
-    }
-    const json& timed = doc["matrix"].value("benchmarks", json::object());
-    for (const json& run : timed.value("benchmarks", json::array())) benchmarks.push_back(run);
-    if (context.empty()) context = timed.value("context", json::object());
-    if (doc.contains("sweep")) {
-      if (sweep_options.is_null()) sweep_options = doc["sweep"]["options"];
-      if (doc["sweep"]["options"] != sweep_options)
-        throw std::invalid_argument(file + ": its sweep's options differ from " +
-                                    shards.front()->first + "'s: not a shard of the same run");
-      for (const json& p : doc["sweep"]["points"]) {
-        contents.add(sweep_case_key(p["surface_type"], p["method"]));
-        points.push_back(p);
-      }
-      for (const json& k : doc["sweep"]["confirmations"]) confirmations.push_back(k);
-    }
-    if (doc.contains("scaling")) {
-      for (const json& s : doc["scaling"]["series"]) {
-        contents.add(scaling_case_key(s["family"], s["backend"], s["method"]));
-        series.push_back(s);
-      }
-      const json& runs = doc["scaling"].value("benchmarks", json::object());
-      for (const json& run : runs.value("benchmarks", json::array()))
-        scaling_benchmarks.push_back(run);
-    }
-    const json& stages = doc.value("seconds", json::object());
-    for (const auto& [stage, s] : stages.items())
-      seconds[stage] = seconds.value(stage, 0.0) + s.get<double>();
+    for (const std::string& key : report_part_keys(doc)) contents.add(key);
+    contents.complete();
+    parts.emplace_back(file, &doc);
     per_shard.push_back(
         {{"file", file},
          {"host", doc["fingerprint"].value("host", json(""))},
          {"seconds", doc.value("seconds", json::object())},
          {"expected_seconds", doc["shard"]["costs"][doc["shard"]["index"].get<size_t>() - 1]}});
-    contents.complete();
   }
-
   json out = merged_header(files);
   out["created"] = now_utc();
   out["registry"] = first["registry"];
-  out["seconds"] = seconds;
+  out.update(assemble_report(first, parts, keys));
   out["shards"] = per_shard;
-  out["matrix"] = {{"cases", json::array()},
-                   {"skipped", first["matrix"]["skipped"]},
-                   {"benchmarks", {{"context", context}, {"benchmarks", benchmarks}}}};
-  for (const json& key : list)
-    if (matrix.count(key.get<std::string>()))
-      out["matrix"]["cases"].push_back(matrix[key.get<std::string>()]);
-  if (!sweep_options.is_null())
-    out["sweep"] = merged_sweep(sweep_options, std::move(points), std::move(confirmations),
-                                first["options"]["scenes"],
-                                sweep_options.value("methods", first["registry"]["methods"]));
-  if (first.contains("scaling")) {
-    const auto key = [&](const json& s) {
-      return position.at(scaling_case_key(s["family"], s["backend"], s["method"]));
-    };
-    std::stable_sort(series.begin(), series.end(),
-                     [&](const json& a, const json& b) { return key(a) < key(b); });
-    out["scaling"] = {{"series", series},
-                      {"skipped", first["scaling"]["skipped"]},
-                      {"benchmarks", {{"context", context}, {"benchmarks", scaling_benchmarks}}}};
-  }
   out["ranking"] = rank_backends(out["matrix"]);
   out["recommendation"] = recommend(out["ranking"], out.value("sweep", json::object()));
   return out;

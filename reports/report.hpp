@@ -46,6 +46,62 @@ using ReportProgress =
 nlohmann::json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
                           const ReportProgress& progress);
 
+// The results' header: "format", "created", "fingerprint", "registry" (the lists make_report.py
+// draws by) and "options".
+nlohmann::json report_header(const std::vector<Scene>& scenes, const ReportOptions& options);
+
+// The conformance suites of a report's stages: the sweep fixes its suite's mask (one truth for
+// every point), so a worker that runs matrix cases after sweep groups keeps one apart.
+struct ReportSuites {
+  conformance::Suite& matrix;
+  conformance::Suite& sweep;
+};
+
+// Measures the report's cases that `holds` holds (every case where it is empty): {"matrix"
+// (run_matrix's), "sweep" (run_sweep's), "scaling" (run_scaling's), "seconds" per stage}; a stage
+// of which it holds no case is left out, unless `every_stage` (a shard's results have each
+// enabled stage). The matrix runs on `backends` where given (a worker makes them once). A
+// supervised report runs one case a part in its workers and puts them together
+// (assemble_report).
+nlohmann::json run_report_part(const std::vector<Scene>& scenes, const ReportOptions& options,
+                               const std::function<bool(const std::string& key)>& holds,
+                               const ReportSuites& suites, const ReportProgress& progress,
+                               const MatrixBackends* backends, bool every_stage);
+
+// The case keys a part (or a shard's results) holds results of, in its order: matrix cases,
+// sweep groups, scaling series.
+std::vector<std::string> report_part_keys(const nlohmann::json& part);
+
+// Puts parts of one run together (run_report_part's, or shards' results, each with its name
+// for errors), in the run's order `keys` (report_cases'): {"matrix": the cases, with the
+// benchmark runs and the skipped backends; "sweep": the points and re-checks, analysed again
+// (merged_sweep); "scaling": the series; "seconds": summed per stage}. `header` is the run's
+// (report_header's: options.scenes, registry.methods). Throws std::invalid_argument where two
+// parts' sweeps were run with other options.
+nlohmann::json assemble_report(
+    const nlohmann::json& header,
+    const std::vector<std::pair<std::string, const nlohmann::json*>>& parts,
+    const std::vector<std::string>& keys);
+
+// A case a supervised report did not finish (`record`: supervise()'s crash, timeout or
+// out_of_memory, or {"error"} where the case threw) as the results' "unfinished" list has it:
+// {"key", "stage" (matrix, sweep or scaling), "verdict" (crash, timeout, out_of_memory or
+// error), "error" (unfinished_summary's words), and the record's seconds, signal_name,
+// exit_code, deadline_seconds and stderr_tail}.
+nlohmann::json unfinished_entry(const std::string& key, const nlohmann::json& record);
+// A matrix case among them as a part for assemble_report: the case at its place in the matrix,
+// named as a measured one (name, backend, scene, surface_type, method, width, height) with
+// "verdict" and "error" (unfinished_summary's words), so that the ranking counts it as an error
+// and the gate as a regression. Null for a sweep group or a scaling series, whose results simply
+// lack it.
+nlohmann::json unfinished_part(const std::string& key, const nlohmann::json& record,
+                               const std::vector<Scene>& scenes, const ReportOptions& options);
+
+// What a whole run makes of its measured results: "ranking", "recommendation" and, with matrix
+// images, the oracle's frames and the "gallery"; seconds.gallery.
+void finish_report(nlohmann::json& results, const std::vector<Scene>& scenes,
+                   const ReportOptions& options);
+
 // Merges the results of a sharded `flatmarch report` (each file's JSON, with its name for
 // errors), all of one machine: checks that they are the shards 1..N of one run (as
 // merge_conformance) and returns the whole run's results as run_report writes them, the

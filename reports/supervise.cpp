@@ -10,8 +10,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -355,6 +357,27 @@ void supervise(const WorkerOptions& options, const std::vector<SupervisedCase>& 
     done(c.key, record);
   }
   if (worker) worker->finish(10.0);
+}
+
+std::string unfinished_summary(const json& record, bool loud) {
+  const std::string verdict = record.value("verdict", record.contains("error") ? "error" : "");
+  std::string what = verdict == kVerdictOutOfMemory ? (loud ? "OUT OF MEMORY" : "out of memory")
+                     : verdict.empty()              ? (loud ? "ERROR" : "error")
+                                                    : verdict;
+  if (loud)
+    std::transform(what.begin(), what.end(), what.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  if (record.contains("signal_name")) what += " (" + record["signal_name"].get<std::string>() + ")";
+  if (record.contains("exit_code"))
+    what += " (exit " + std::to_string(record["exit_code"].get<int>()) + ")";
+  if (record.contains("error")) what += ": " + record["error"].get<std::string>();
+  if (record.contains("seconds")) {
+    char seconds[64];
+    std::snprintf(seconds, sizeof seconds, " after %.1f s", record["seconds"].get<double>());
+    what += seconds;
+  }
+  if (record.contains("deadline_seconds")) what += ", its deadline";
+  return what;
 }
 
 void serve_cases(const std::function<json(const std::string& key)>& run) {

@@ -50,6 +50,11 @@ inline constexpr const char* kVerdictOutOfMemory = "out_of_memory";
 // Whether `verdict` is one of them.
 bool is_supervision_verdict(const std::string& verdict);
 
+// What ended a case without a result, from its record (supervise()'s, or {"error"} where the
+// case threw), in a few words: "crash (SIGSEGV) after 2.1 s", "timeout after 30.0 s, its
+// deadline", "error: WHAT"; the verdict in capitals where `loud` (a console table's).
+std::string unfinished_summary(const nlohmann::json& record, bool loud = false);
+
 // How a worker is started and watched.
 struct WorkerOptions {
   // The worker's command line: this program (readlink of /proc/self/exe) and its arguments.

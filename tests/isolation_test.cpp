@@ -141,13 +141,33 @@ TEST(IsolatedConform, ACrashAHangAndAnOutOfMemoryCostOnlyTheirOwnCases) {
   EXPECT_NE(faulty.out.find("3 did not finish"), std::string::npos) << faulty.out;
 }
 
-// `flatmarch conform` of the scalar backend over a few scenes, into `json_path`.
-std::vector<std::string> small_conform(const std::string& json_path) {
-  std::vector<std::string> argv{self(),    kCliFlag, "conform",   "--backend",
-                                "scalar",  "--size", "32x18",     "--json",
-                                json_path, "-q",     "--gallery", FLATMARCH_SOURCE_DIR "/scenes"};
-  for (const char* scene : {"torus", "l_shape", "klein_bottle"})
-    argv.insert(argv.end(), {"--scene", scene});
+// A small `flatmarch report` of the scalar backend into `out`: two matrix cases, one sweep group
+// (both scenes are translation surfaces) and eight scaling series, 11 cases in all.
+std::vector<std::string> small_report(const std::string& out) {
+  std::vector<std::string> argv{self(),
+                                kCliFlag,
+                                "report",
+                                "--backend",
+                                "scalar",
+                                "--method",
+                                "analytic",
+                                "--size",
+                                "32x18",
+                                "--conform-size",
+                                "32x18",
+                                "--sweep-size",
+                                "16x9",
+                                "--min-time",
+                                "0.001",
+                                "--repetitions",
+                                "2",
+                                "--no-html",
+                                "-q",
+                                "-o",
+                                out,
+                                "--gallery",
+                                FLATMARCH_SOURCE_DIR "/scenes"};
+  for (const char* scene : {"torus", "l_shape"}) argv.insert(argv.end(), {"--scene", scene});
   return argv;
 }
 
@@ -167,19 +187,48 @@ std::vector<std::string> journal_keys(const std::string& path) {
   return keys;
 }
 
-// Runs stopped by SIGKILL at random moments (the process gone at once, as by a scheduler or a
+// A report's deterministic figures: each matrix case's accuracy and frame counters, each sweep
+// point's accuracy and steps, each scaling series' steps and crossings (timings left out).
+json report_figures(const json& results) {
+  json out = {{"matrix", json::array()}, {"sweep", json::array()}, {"scaling", json::array()}};
+  for (const json& c : results["matrix"]["cases"]) {
+    json counters = json::object();
+    for (const char* k : {"steps_mean", "steps_p99", "crossings_mean", "out_of_steps"})
+      counters[k] = c["counters"].value(k, -1.0);
+    json accuracy = c["accuracy"];
+    accuracy.erase("seconds");
+    out["matrix"].push_back({{"name", c["name"]}, {"accuracy", accuracy}, {"counters", counters}});
+  }
+  for (json p : results["sweep"]["points"]) {
+    p.erase("time_ms");
+    p["accuracy"].erase("seconds");
+    out["sweep"].push_back(p);
+  }
+  for (const json& s : results["scaling"]["series"])
+    out["scaling"].push_back({{"family", s["family"]},
+                              {"backend", s["backend"]},
+                              {"x", s["x"]},
+                              {"steps_mean", s["steps_mean"]},
+                              {"crossings_mean", s["crossings_mean"]}});
+  return out;
+}
+
+// Reports stopped by SIGKILL at random moments (the process gone at once, as by a scheduler or a
 // lost machine) and resumed: every one ends with the uninterrupted run's figures, each case
 // measured once.
-TEST(ResumedConform, RunsKilledAtRandomAndResumedEqualAnUninterruptedOne) {
+TEST(ResumedReport, RunsKilledAtRandomAndResumedEqualAnUninterruptedOne) {
   const std::string dir = test::make_temp_dir();
   const auto whole_start = std::chrono::steady_clock::now();
-  const test::ProcessResult whole = test::run_process(small_conform(dir + "/whole.json"), 300.0);
+  const test::ProcessResult whole = test::run_process(small_report(dir + "/whole"), 300.0);
   const double whole_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - whole_start).count();
   ASSERT_FALSE(whole.timed_out);
-  ASSERT_LE(whole.exit_code, 1) << whole.err;
-  const json expected = read_json(dir + "/whole.json");
-  ASSERT_EQ(expected["cases"].size(), 9u);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  const json expected = report_figures(read_json(dir + "/whole/results.json"));
+  ASSERT_EQ(expected["matrix"].size(), 2u);
+  ASSERT_EQ(expected["scaling"].size(), 8u);
+  const size_t cases = journal_keys(dir + "/whole/results.json.journal").size();
+  ASSERT_EQ(cases, 11u);
 #ifdef FLATMARCH_SANITIZE_BUILD
   const int runs = 4;
 #else
@@ -189,26 +238,88 @@ TEST(ResumedConform, RunsKilledAtRandomAndResumedEqualAnUninterruptedOne) {
   std::uniform_real_distribution<double> moment(0.02, 1.1 * whole_seconds);
   int interrupted = 0;
   for (int run = 0; run < runs; ++run) {
-    const std::string out = dir + "/run-" + std::to_string(run) + ".json";
-    const test::ProcessResult first = test::run_process(small_conform(out), moment(random));
+    const std::string out = dir + "/run-" + std::to_string(run);
+    const test::ProcessResult first = test::run_process(small_report(out), moment(random));
     interrupted += first.timed_out;
     // Resumed until it finishes (the first resume does, unless it too is stopped: it is not).
-    const test::ProcessResult rest = test::run_process(with(small_conform(out), "--resume"), 300.0);
+    const test::ProcessResult rest = test::run_process(with(small_report(out), "--resume"), 300.0);
     ASSERT_FALSE(rest.timed_out);
-    ASSERT_LE(rest.exit_code, 1) << rest.err;
-    const json got = read_json(out);
-    ASSERT_EQ(got["cases"].size(), expected["cases"].size()) << "run " << run;
-    for (size_t k = 0; k < got["cases"].size(); ++k)
-      EXPECT_EQ(deterministic(got["cases"][k]), deterministic(expected["cases"][k]))
-          << "run " << run << ", case " << k;
+    ASSERT_EQ(rest.exit_code, 0) << rest.err;
+    EXPECT_EQ(report_figures(read_json(out + "/results.json")), expected) << "run " << run;
     // Each case recorded once, none lost: the journal holds every key once.
-    std::vector<std::string> keys = journal_keys(out + ".journal");
+    std::vector<std::string> keys = journal_keys(out + "/results.json.journal");
     std::sort(keys.begin(), keys.end());
     EXPECT_EQ(std::adjacent_find(keys.begin(), keys.end()), keys.end()) << "a case twice";
-    EXPECT_EQ(keys.size(), 9u) << "run " << run;
+    EXPECT_EQ(keys.size(), cases) << "run " << run;
   }
   // Most runs were stopped part way (the moments reach past the run's end for a few).
   EXPECT_GE(interrupted, runs / 2);
+}
+
+// A report whose faulty backend crashes on one case: the case is in the results with its
+// verdict, the others as a clean run's, and the gate calls it a regression where the baseline
+// had it pass.
+TEST(IsolatedReport, ACrashedCaseIsRecordedAndIsARegression) {
+  const std::string dir = test::make_temp_dir();
+  const auto report = [&](const std::string& out, std::vector<std::string> more) {
+    std::vector<std::string> argv = small_report(out);
+    argv.insert(argv.end(), {"--backend", "faulty", "--no-sweep", "--no-scaling"});
+    argv.insert(argv.end(), more.begin(), more.end());
+    return test::run_process(argv, 300.0);
+  };
+  unsetenv("FLATMARCH_FAULTY");
+  const test::ProcessResult clean =
+      report(dir + "/clean", {"--isolate", "none", "--write-baseline", dir + "/baseline.json"});
+  ASSERT_EQ(clean.exit_code, 0) << clean.err;
+  setenv("FLATMARCH_FAULTY", "crash=torus/analytic", 1);
+  const test::ProcessResult crashed = report(dir + "/crashed", {});
+  unsetenv("FLATMARCH_FAULTY");
+  ASSERT_EQ(crashed.exit_code, 0) << crashed.err;
+  EXPECT_NE(crashed.out.find("1 cases did not finish"), std::string::npos) << crashed.out;
+  const json a = read_json(dir + "/clean/results.json"),
+             b = read_json(dir + "/crashed/results.json");
+  ASSERT_EQ(a["matrix"]["cases"].size(), 4u);
+  ASSERT_EQ(b["matrix"]["cases"].size(), 4u);
+  for (size_t k = 0; k < 4; ++k) {
+    const json& c = b["matrix"]["cases"][k];
+    ASSERT_EQ(c["name"], a["matrix"]["cases"][k]["name"]) << "the cases in another order";
+    if (c["backend"] == "faulty" && c["scene"] == "torus") {
+      EXPECT_EQ(c["verdict"], "crash") << c.dump();
+      EXPECT_NE(c["error"].get<std::string>().find("crash"), std::string::npos);
+    } else {
+      EXPECT_EQ(c["accuracy"], a["matrix"]["cases"][k]["accuracy"]) << c["name"];
+    }
+  }
+  ASSERT_EQ(b["unfinished"].size(), 1u);
+  EXPECT_EQ(b["unfinished"][0]["key"], "matrix/faulty/analytic/torus");
+  EXPECT_EQ(b["unfinished"][0]["stage"], "matrix");
+  // The ranking counts the crash as an error of its backend.
+  for (const json& r : b["ranking"])
+    if (r["backend"] == "faulty") {
+      EXPECT_EQ(r["errors"], 1) << r.dump();
+    }
+  // A baseline in which the case passed (the faulty backend fails everything it finishes, so the
+  // clean run's baseline is edited to say it passed): the crash is a regression of its verdict.
+  json baseline = read_json(dir + "/baseline.json");
+  bool edited = false;
+  for (auto& [name, figures] : baseline["cases"].items())
+    if (name.find("faulty/analytic/torus") == 0) {
+      figures["passed"] = true;
+      figures["verdict"] = "pass";
+      edited = true;
+    }
+  ASSERT_TRUE(edited) << baseline["cases"].dump();
+  { std::ofstream(dir + "/passed.json") << baseline.dump(); }
+  setenv("FLATMARCH_FAULTY", "crash=torus/analytic", 1);
+  const test::ProcessResult gated = report(dir + "/gated", {"--baseline", dir + "/passed.json"});
+  unsetenv("FLATMARCH_FAULTY");
+  EXPECT_EQ(gated.exit_code, 1) << gated.out << gated.err;
+  const json gate = read_json(dir + "/gated/gate.json");
+  bool found = false;
+  for (const json& g : gate["regressions"])
+    if (g["case"].get<std::string>().find("faulty/analytic/torus") == 0 && g["figure"] == "verdict")
+      found = g["was"] == "pass" && g["now"] == "crash";
+  EXPECT_TRUE(found) << gate.dump();
 }
 
 // SIGTERM (a scheduler's notice) and SIGINT (Ctrl-C): the case under way abandoned, the

@@ -1,0 +1,71 @@
+// A command's cases run supervised and journaled (issue 74): the options `conform`, `report` and
+// `sweep` share (--isolate, --deadline-scale, --deadline-floor, --worker-memory, --resume, the
+// hidden --worker), and the run itself — the journal beside the output started or resumed, the
+// cases not yet in it run in watched workers (reports/supervise.hpp) or here, each appended to it
+// as it finishes, and SIGINT or SIGTERM answered with how to resume.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "reports/journal.hpp"
+
+namespace flatmarch::cli {
+
+struct SupervisionOptions {
+  std::string isolate = "worker";
+  double deadline_scale = 10.0, deadline_floor = 30.0, worker_memory_gib = 0.0;
+  bool resume = false;
+  bool worker = false;  // this process is a worker of a supervised run
+};
+
+// Adds --isolate, --deadline-scale, --deadline-floor, --worker-memory, --resume and --worker
+// to `cmd`; `journal` says where the journal lies ("beside --json, JSON.journal").
+void add_supervision_options(CLI::App& cmd, SupervisionOptions& o, const std::string& journal);
+
+// A case of a run: its key (what a worker is handed) and its expected seconds (the cost model's).
+struct RunCase {
+  std::string key;
+  double cost_seconds = 0.0;
+};
+
+// A supervised run of `command` ("conform"), its journal at `journal`, described for the journal
+// by the machine's `fingerprint` and the `options` that shape its results.
+struct SupervisedRun {
+  std::string command;
+  std::filesystem::path journal;
+  nlohmann::json fingerprint, options;
+  std::vector<RunCase> cases;
+  bool quiet = false;
+};
+
+// Runs the run's cases, those its journal does not hold already (with --resume): each in a
+// worker (`flatmarch COMMAND ... --worker`, which answers it with serve_cases) or, with
+// --isolate none, here by `run_here(key)`. Each finished case's record is appended to the
+// journal, then `show(key, record)` is called: once a case, in the run's order, the journal's
+// first. A case its worker failed has the supervisor's record (a crash, timeout or
+// out_of_memory verdict). Returns the records by key. On SIGINT or SIGTERM ends the case under
+// way, prints how to resume and throws reports::Interrupted (cli::run exits 130 or 143).
+// Throws UsageError for a journal it may not start or resume. complete() the journal returned in
+// `journal_out` once the results are written.
+std::map<std::string, nlohmann::json> run_supervised(
+    const SupervisedRun& run, const SupervisionOptions& o,
+    const std::function<nlohmann::json(const std::string& key)>& run_here,
+    const std::function<void(const std::string& key, const nlohmann::json& record)>& show,
+    std::optional<reports::Journal>& journal_out);
+
+// What ended a case without a result, in a line: "CRASH (SIGSEGV) after 2.1 s", then the last
+// lines its worker wrote on its standard error, indented; for a table.
+std::string unfinished_lines(const std::string& key, const nlohmann::json& record);
+
+// A case record's verdict: pass, limit or fail (conformance's), crash, timeout or out_of_memory
+// (the supervisor's), or "error" (the case threw: {"error"}).
+std::string record_verdict(const nlohmann::json& record);
+
+}  // namespace flatmarch::cli
