@@ -96,7 +96,16 @@ VERDICTS = {
              "ctest expects it and the regression gate holds it from getting worse",
     "fail": "beyond a threshold in any other way",
     "error": "the backend could not render or time the case",
+    "crash": "its worker process died while it ran (a signal, or an exit part way): the run went on in a "
+             "fresh worker",
+    "timeout": "it overran its deadline (the cost model's time times --deadline-scale, at least "
+               "--deadline-floor seconds) and its worker was ended",
+    "out_of_memory": "it ran out of the worker's address-space limit (--worker-memory)",
 }
+# The verdicts of a supervised run's cases that did not finish (reports/supervise.hpp): shown only
+# where a case has one, and counted with fail and error as bad.
+UNFINISHED = ("crash", "timeout", "out_of_memory")
+BAD = ("fail", "error") + UNFINISHED
 
 
 def use_registry(all_results):
@@ -173,6 +182,8 @@ def pct(share):
 def verdict(case):
     """A case's verdict: pass, limit, fail, or error (results written before verdicts: pass or
     fail by its checks); None for a case not measured against the oracle."""
+    if case.get("verdict") in UNFINISHED:
+        return case["verdict"]
     if "error" in case:
         return "error"
     a = case.get("accuracy")
@@ -236,19 +247,21 @@ def summary_section(results, cases):
         per.setdefault(c["backend"], {}).setdefault(c["method"], {k: 0 for k in VERDICTS})[v] += 1
     judged = sum(counts.values())
     boxes = "".join(f'<div class="count {v}"><b>{counts[v]}</b> {v}</div>' for v in VERDICTS
-                    if v != "error" or counts[v])
+                    if v not in ("error",) + UNFINISHED or counts[v])
     rows = []
     for b, methods in per.items():
         row = [b]
         for m in METHODS:
             n = methods.get(m)
-            row.append(td(" · ".join(f"{n[v]} {v}" for v in VERDICTS if n[v] or v != "error") if n else "-",
-                          "bad" if n and (n["fail"] or n["error"]) else "limit" if n and n["limit"] else ""))
+            row.append(td(" · ".join(f"{n[v]} {v}" for v in VERDICTS
+                                     if n[v] or v not in ("error",) + UNFINISHED) if n else "-",
+                          "bad" if n and any(n[v] for v in BAD) else "limit" if n and n["limit"] else ""))
         rows.append(row)
     return (f'<h2 id=summary>Verdicts</h2><div class="counts">{boxes}</div>'
             f'<p>{judged} cases (backend &times; method &times; scene), each measured against the oracle at '
             f'{esc(results["options"]["conform_size"])} with one set of thresholds. '
-            + "; ".join(f"<b>{v}</b>: {esc(m)}" for v, m in VERDICTS.items())
+            + "; ".join(f"<b>{v}</b>: {esc(m)}" for v, m in VERDICTS.items()
+                        if v not in UNFINISHED or counts[v])
             + '. Each case that did not pass is listed with the checks it failed and why in '
               '<a href="#failures">Failures</a>; the terms are defined in <a href="#definitions">Definitions</a>.</p>'
             + table(["backend"] + METHODS, rows))
@@ -761,6 +774,24 @@ def steps_heatmap_section(cases):
             + figure_html(fig, "steps heatmap") + lane_table)
 
 
+def unfinished_section(results):
+    """The cases of a supervised run that did not finish (matrix cases, sweep groups, scaling
+    series): what ended each, and the end of what its worker wrote on its standard error."""
+    unfinished = results.get("unfinished", [])
+    if not unfinished:
+        return ""
+    rows = []
+    for u in unfinished:
+        tail = [line for line in u.get("stderr_tail", "").splitlines() if line.strip()][-6:]
+        rows.append([u["key"], f"<td>{verdict_html(u['verdict'])}</td>", u["error"],
+                     "<td><pre>" + esc("\n".join(tail)) + "</pre></td>" if tail else "-"])
+    return ("<h2 id=unfinished>Cases that did not finish</h2><p>Each case ran in a watched worker process; "
+            "these ended it (the run went on in a fresh worker). A matrix case among them counts as an error "
+            "of its backend in the ranking and as a regression at the gate; a sweep group or scaling series "
+            "is missing from its chart.</p>"
+            + table(["case", "verdict", "what ended it", "its worker's last words"], rows))
+
+
 def failure_section(cases):
     rows = []
     totals = {}
@@ -776,15 +807,16 @@ def failure_section(cases):
             t[f] += c.get("accuracy", {}).get("failures", {}).get(f, 0)
     for (b, m), t in sorted(totals.items()):
         rows.append([b, m, t["cases"], t["pass"], td(t["limit"], "limit" if t["limit"] else ""),
-                     td(t["fail"] + t["error"], "bad" if t["fail"] + t["error"] else "")] +
+                     td(sum(t[v] for v in BAD), "bad" if any(t[v] for v in BAD) else "")] +
                     [td(t[f], "bad" if t[f] else "") for f in FAILURES])
     out = ["<h2 id=failures>Failures</h2><p>Per backend and method: the cases of each verdict, and the rays of "
            "each failure class summed over the scenes (decided pixels of the conformance frames and diverging "
            "probe rays; see <a href=\"#definitions\">Definitions</a>). Then each case that did not pass, with "
            "every check it failed: its measured value against the threshold, and what the check measures (the "
            "backends whose cases read alike share a row).</p>",
-           table(["backend", "method", "cases", "pass", "limit", "fail or error"] + FAILURES, rows)]
-    order = {"fail": 0, "error": 0, "limit": 1}
+           table(["backend", "method", "cases", "pass", "limit", "fail, error or unfinished"] + FAILURES,
+                 rows)]
+    order = {v: 0 for v in BAD} | {"limit": 1}
     bad = sorted((c for c in cases if verdict(c) in order),
                  key=lambda c: (order[verdict(c)], c["scene"], c["method"], c["backend"]))
     # Cases whose verdict and reasons read alike (the same scene and method on several backends)
@@ -792,7 +824,7 @@ def failure_section(cases):
     groups = {}
     for c in bad:
         v = verdict(c)
-        if v == "error":
+        if v == "error" or v in UNFINISHED:
             lines = [esc(c["error"])]
         else:
             a = c["accuracy"]
@@ -1025,10 +1057,11 @@ img.chart {{ max-width: 100%; display: block; margin: 0.5em 0; }} img.frame {{ w
 .counts {{ display: flex; gap: 0.8em; margin: 0.6em 0; }}
 .count {{ padding: 0.4em 1em; border-radius: 4px; font-size: 1.2em; border: 1px solid #ccc; }}
 .count b {{ font-size: 1.4em; }} .count.pass {{ background: #dff3df; }} .count.limit {{ background: #fff1c8; }}
-.count.fail, .count.error {{ background: #fdd; }}
+.count.fail, .count.error, .count.crash, .count.timeout, .count.out_of_memory {{ background: #fdd; }}
 .verdict {{ padding: 0 0.4em; border-radius: 3px; font-weight: bold; font-size: 0.9em; }}
 .verdict.pass {{ background: #dff3df; color: #060; }} .verdict.limit {{ background: #fff1c8; color: #750; }}
-.verdict.fail, .verdict.error {{ background: #fdd; color: #a00; }}
+.verdict.fail, .verdict.error, .verdict.crash, .verdict.timeout, .verdict.out_of_memory {{
+  background: #fdd; color: #a00; }}
 .verdict-line {{ font-size: 1.05em; }} table.reasons td {{ max-width: 900px; }}
 table.recommended img.frame {{ width: 320px; }} ul.legend {{ columns: 2; margin: 0.3em 0; }}
 .swatch {{ display: inline-block; width: 0.9em; height: 0.9em; border: 1px solid #555; margin: 0 0.25em;
@@ -1045,6 +1078,7 @@ def one_machine(results, images, previous=None, previous_path=""):
                 ("regression", "regression gate", regression_section(results)),
                 ("previous", "since the earlier run", previous_section(results, previous, previous_path)),
                 ("failures", "failures", failure_section(cases)),
+                ("unfinished", "unfinished", unfinished_section(results)),
                 ("ambiguity", "ambiguity", ambiguity_section(cases)),
                 ("speed", "speed vs accuracy", speed_accuracy_section(cases)),
                 ("gallery", "gallery", gallery_section(results, images)),
