@@ -2,13 +2,18 @@
 // the stable region, Pareto front and recommendation per surface type.
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <memory>
+#include <optional>
 
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
+#include "cli/supervised.hpp"
 #include "conformance/suite.hpp"
 #include "reports/fingerprint.hpp"
 #include "reports/shard.hpp"
+#include "reports/supervise.hpp"
+#include "reports/report.hpp"
 #include "reports/sweep.hpp"
 
 namespace flatmarch::cli {
@@ -28,6 +33,7 @@ void add_sweep(CLI::App& app) {
     std::vector<std::string> galleries = {"scenes"};
     std::string size = "64x36", json = "sweep.json", shard;
     reports::SweepOptions sweep;
+    SupervisionOptions supervision;
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
@@ -52,6 +58,7 @@ void add_sweep(CLI::App& app) {
                   "I/N: sweep only shard I of N of the groups (surface type x method, each with "
                   "its precisions, grid and re-checks; split by their expected cost, the same in "
                   "every shard); `flatmarch merge` puts the shards' JSON together");
+  add_supervision_options(*cmd, o->supervision, "beside --json: JSON.journal");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->callback([o] {
     std::tie(o->sweep.width, o->sweep.height) = parse_size("--size", o->size);
@@ -83,22 +90,80 @@ void add_sweep(CLI::App& app) {
         }))
       throw UsageError("--precision: the " + o->sweep.backend + " backend marches in f32 only");
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
-    json shard;
-    if (!o->shard.empty()) {
-      reports::ShardPlan plan = reports::plan_shard(
-          parse_shard_option(o->shard), reports::sweep_cases(scenes, o->sweep), "groups");
-      shard = std::move(plan.record);
-      o->sweep.holds = plan.holds;
-      // Said even when quiet: the first line of a scheduler's log.
-      std::fprintf(stderr, "sweep: %s\n", plan.summary.c_str());
-    }
+    // The groups (a shard's), each run in a worker (or here, --isolate none), journaled.
+    const std::vector<std::pair<std::string, double>> groups =
+        reports::sweep_cases(scenes, o->sweep);
+    std::optional<reports::ShardPlan> plan;
+    if (!o->shard.empty())
+      plan = reports::plan_shard(parse_shard_option(o->shard), groups, "groups");
     conformance::Suite suite;
+    // One group here: its points and re-checks.
+    const auto run_group = [&](const std::string& key) -> json {
+      reports::SweepOptions one = o->sweep;
+      one.holds = [&](const std::string& k) { return k == key; };
+      try {
+        return reports::run_sweep(scenes, one, suite, nullptr);
+      } catch (const std::bad_alloc&) {
+        throw;  // a worker answers out_of_memory
+      } catch (const std::exception& e) {
+        return {{"error", e.what()}};
+      }
+    };
+    if (o->supervision.worker) {
+      reports::serve_cases(run_group);
+      return;
+    }
+    // Said even when quiet: the first line of a scheduler's log.
+    if (plan) std::fprintf(stderr, "sweep: %s\n", plan->summary.c_str());
+    json options = {{"size", o->size},
+                    {"backend", o->sweep.backend},
+                    {"eps", o->sweep.eps},
+                    {"offset_factors", o->sweep.offset_factors},
+                    {"offset_fixed", o->sweep.offset_fixed},
+                    {"repetitions", o->sweep.repetitions},
+                    {"max_steps", o->sweep.params.max_steps},
+                    {"precisions", json::array()}};
+    for (Precision p : o->sweep.precisions) options["precisions"].push_back(p == Precision::f32 ? "f32" : "f64");
+    if (plan) options["shard"] = plan->record;
+    SupervisedRun run{.command = "sweep",
+                      .journal = o->json + ".journal",
+                      .fingerprint = reports::hardware_fingerprint(),
+                      .options = options,
+                      .cases = {},
+                      .quiet = o->quiet};
+    for (const auto& [key, cost] : groups)
+      if (!plan || plan->holds(key)) run.cases.push_back({key, cost});
     ProgressReporter progress("sweep", o->quiet);
-    json result =
-        reports::run_sweep(scenes, o->sweep, suite, [&](const std::string&, int done, int total) {
-          progress(static_cast<double>(done) / total);
-        });
+    size_t done = 0;
+    json unfinished = json::array();
+    const auto show = [&](const std::string& key, const json& record) {
+      if (record.contains("verdict") || record.contains("error")) {
+        std::fputs(("sweep: " + unfinished_lines(key, record)).c_str(), stderr);
+        unfinished.push_back(reports::unfinished_entry(key, record));
+      }
+      progress(static_cast<double>(++done) / static_cast<double>(run.cases.size()));
+    };
+    std::optional<reports::Journal> journal;
+    const std::map<std::string, json> records =
+        run_supervised(run, o->supervision, run_group, show, journal);
     progress.done();
+    // The groups' points and re-checks put together, analysed again.
+    json points = json::array(), confirmations = json::array(), sweep_options;
+    for (const RunCase& c : run.cases) {
+      const json& part = records.at(c.key);
+      if (!part.contains("points")) continue;
+      if (sweep_options.is_null()) sweep_options = part["options"];
+      for (const json& p : part["points"]) points.push_back(p);
+      for (const json& k : part["confirmations"]) confirmations.push_back(k);
+    }
+    json scene_names = json::array(), methods = json::array();
+    for (const Scene& s : scenes) scene_names.push_back(s.name);
+    for (Method m : o->sweep.methods) methods.push_back(to_string(m));
+    if (sweep_options.is_null()) sweep_options = {{"methods", methods}};
+    json result = reports::merged_sweep(sweep_options, std::move(points), std::move(confirmations),
+                                        scene_names, methods);
+    result["unfinished"] = unfinished;
+    json shard = plan ? plan->record : json();
     result["format"] = "flatmarch-sweep/1";
     result["fingerprint"] = reports::hardware_fingerprint();
     result["options"]["scenes"] = json::array();
@@ -136,6 +201,10 @@ void add_sweep(CLI::App& app) {
                   g["method"].get<std::string>().c_str(), g["precision"].get<std::string>().c_str(),
                   g["stable"].size(), g["grid"].size(), rec.c_str(), front.c_str());
     }
+    journal->complete();
+    for (const json& u : unfinished)
+      std::printf("did not finish: %s  %s\n", u["key"].get<std::string>().c_str(),
+                  u["error"].get<std::string>().c_str());
     std::printf("wrote %s\n", o->json.c_str());
     if (!no_images.empty()) say_left_out("sweep", "Yee's perceptual check", kPerceptualLeftOut);
   });
