@@ -365,12 +365,10 @@ void add_report(CLI::App& app) {
       if (!o->quiet)
         std::fprintf(stderr, "report: %s skipped: %s\n", skip["backend"].get<std::string>().c_str(),
                      skip["reason"].get<std::string>().c_str());
-    int unfinished = 0;
     const auto show = [&](const std::string& key, const json& record) {
       const std::string stage = key.substr(0, key.find('/'));
       const bool finished = !record.contains("verdict") && !record.contains("error");
       if (!finished) {
-        ++unfinished;
         if (progress.reporter) progress.reporter->done();
         progress.reporter.reset();
         progress.stage.clear();

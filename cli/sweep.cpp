@@ -11,9 +11,9 @@
 #include "cli/supervised.hpp"
 #include "conformance/suite.hpp"
 #include "reports/fingerprint.hpp"
+#include "reports/report.hpp"
 #include "reports/shard.hpp"
 #include "reports/supervise.hpp"
-#include "reports/report.hpp"
 #include "reports/sweep.hpp"
 
 namespace flatmarch::cli {
@@ -123,7 +123,8 @@ void add_sweep(CLI::App& app) {
                     {"repetitions", o->sweep.repetitions},
                     {"max_steps", o->sweep.params.max_steps},
                     {"precisions", json::array()}};
-    for (Precision p : o->sweep.precisions) options["precisions"].push_back(p == Precision::f32 ? "f32" : "f64");
+    for (Precision p : o->sweep.precisions)
+      options["precisions"].push_back(p == Precision::f32 ? "f32" : "f64");
     if (plan) options["shard"] = plan->record;
     SupervisedRun run{.command = "sweep",
                       .journal = o->json + ".journal",

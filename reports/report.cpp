@@ -221,6 +221,7 @@ double lane_efficiency(const json& counters, double scalar_rays_per_s) {
 json rank_backends(const json& matrix) {
   struct Tally {
     int cases = 0, passed = 0, limits = 0, errors = 0;
+    std::map<std::string, int> unfinished;  // errors that were crash, timeout or out_of_memory
     double log_rays = 0.0;
     int timed = 0;
     std::map<std::string, std::array<double, 4>> methods;  // cases, passed, log rays, timed
@@ -257,6 +258,9 @@ json rank_backends(const json& matrix) {
     m[0] += 1;
     if (c.contains("error")) {
       ++t.errors;
+      // A supervised run's case that did not finish: counted by its verdict too.
+      if (const std::string v = c.value("verdict", ""); is_supervision_verdict(v))
+        ++t.unfinished[v];
       continue;
     }
     // A case at its method's limit (issue 22) is no pass: counted apart.
@@ -324,6 +328,7 @@ json rank_backends(const json& matrix) {
                        {"passed", t.passed},
                        {"limits", t.limits},
                        {"errors", t.errors},
+                       {"unfinished", t.unfinished},
                        {"pass_rate", t.cases ? static_cast<double>(t.passed) / t.cases : 0.0},
                        {"rays_per_s", t.timed ? std::exp(t.log_rays / t.timed) : 0.0},
                        {"methods", methods},
@@ -465,6 +470,12 @@ std::string describe_selection(const json& results, const std::string& type) {
                       ? (", " + std::to_string(b["errors"].get<int>()) + " errors").c_str()
                       : "");
     s += line;
+    // Of those errors, the cases that did not finish: "(1 crash, 1 timeout)".
+    std::string ended;
+    const json unfinished = b.value("unfinished", json::object());
+    for (const auto& [verdict, n] : unfinished.items())
+      ended += (ended.empty() ? "" : ", ") + std::to_string(n.get<int>()) + " " + verdict;
+    if (!ended.empty()) s += " (" + ended + ")";
     if (b.contains("device"))
       s += "  on " + b["device"]["name"].get<std::string>() +
            (b["device"]["software"].get<bool>() ? " (software: a rasteriser on the CPU)" : "") +
@@ -789,11 +800,16 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
   std::vector<std::string> keys;
   for (const json& key : first["shard"]["cases"]) keys.push_back(key.get<std::string>());
   std::vector<std::pair<std::string, const json*>> parts;
-  json per_shard = json::array();
+  json per_shard = json::array(), unfinished = json::array();
   for (const auto* entry : shards) {
     const auto& [file, doc] = *entry;
     ShardContents contents(file, doc["shard"]);
     for (const std::string& key : report_part_keys(doc)) contents.add(key);
+    // A case its shard's worker did not finish is accounted for by its record.
+    for (const json& u : doc.value("unfinished", json::array())) {
+      contents.add(u.at("key").get<std::string>());
+      unfinished.push_back(u);
+    }
     contents.complete();
     parts.emplace_back(file, &doc);
     per_shard.push_back(
@@ -807,6 +823,7 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
   out["registry"] = first["registry"];
   out.update(assemble_report(first, parts, keys));
   out["shards"] = per_shard;
+  out["unfinished"] = unfinished;
   out["ranking"] = rank_backends(out["matrix"]);
   out["recommendation"] = recommend(out["ranking"], out.value("sweep", json::object()));
   return out;

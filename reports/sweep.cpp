@@ -267,7 +267,7 @@ json merged_sweep(const json& options, json points, json confirmations, const js
 
 json merge_sweep(const std::vector<std::pair<std::string, json>>& files) {
   const auto shards = check_shards(files, "flatmarch-sweep/1", "flatmarch sweep");
-  json points = json::array(), confirmations = json::array();
+  json points = json::array(), confirmations = json::array(), unfinished = json::array();
   for (const auto* entry : shards) {
     const auto& [file, doc] = *entry;
     ShardContents contents(file, doc["shard"]);
@@ -276,6 +276,11 @@ json merge_sweep(const std::vector<std::pair<std::string, json>>& files) {
       points.push_back(p);
     }
     for (const json& k : doc.at("confirmations")) confirmations.push_back(k);
+    // A group its shard's worker did not finish is accounted for by its record.
+    for (const json& u : doc.value("unfinished", json::array())) {
+      contents.add(u.at("key").get<std::string>());
+      unfinished.push_back(u);
+    }
     contents.complete();
   }
   const json& first = files.front().second;
@@ -283,6 +288,7 @@ json merge_sweep(const std::vector<std::pair<std::string, json>>& files) {
   out.update(merged_sweep(first["options"], std::move(points), std::move(confirmations),
                           first["options"].value("scenes", json::array()),
                           first["options"].value("methods", json::array())));
+  out["unfinished"] = unfinished;
   return out;
 }
 
