@@ -322,9 +322,20 @@ void add_report(CLI::App& app) {
     const auto run_case = [&](const std::string& key) -> json {
       if (!backends) backends = reports::matrix_backends(r.matrix);
       try {
-        return reports::run_report_part(
+        json part = reports::run_report_part(
             scenes, r, [&](const std::string& k) { return k == key; }, {matrix_suite, sweep_suite},
             nullptr, &*backends, /*every_stage=*/false);
+        // A case this process cannot run (its backend unavailable here, not where the run was
+        // planned) says so, and why, rather than coming back empty.
+        const std::vector<std::string> measured = reports::report_part_keys(part);
+        if (std::find(measured.begin(), measured.end(), key) == measured.end()) {
+          std::string why;
+          for (const json& skip : backends->skipped)
+            why +=
+                "; " + skip["backend"].get<std::string>() + " " + skip["reason"].get<std::string>();
+          return {{"error", "no such case here" + why}};
+        }
+        return part;
       } catch (const std::bad_alloc&) {
         throw;  // a worker answers out_of_memory
       } catch (const std::exception& e) {

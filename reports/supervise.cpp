@@ -399,7 +399,11 @@ void serve_cases(const std::function<json(const std::string& key)>& run) {
     // Never above a limit this process has already (the parent's own, say).
     if (rlimit now{}; ::getrlimit(RLIMIT_AS, &now) == 0 && now.rlim_max != RLIM_INFINITY)
       bytes = std::min(bytes, now.rlim_max);
-    const rlimit as{bytes, bytes};
+    // The soft limit alone: a backend may start a program of its own outside it (the webgl
+    // backend's browser, whose V8 reserves tens of GiB of address space it never touches).
+    rlimit as{};
+    ::getrlimit(RLIMIT_AS, &as);
+    as.rlim_cur = bytes;
     if (bytes > 0 && ::setrlimit(RLIMIT_AS, &as) != 0)
       std::cerr << system_error("worker: RLIMIT_AS") << "\n";
   }

@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -123,8 +124,19 @@ Chromium::Chromium(const std::string& executable, const std::vector<std::string>
   // Its own process group: stop() ends the browser's helper processes with it.
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
   posix_spawnattr_setpgroup(&attributes, 0);
+  // The browser runs outside a supervised worker's address-space limit (reports/supervise.hpp
+  // sets the soft limit alone, for this): V8's cages and WebAssembly's guard regions reserve tens
+  // of GiB of address space they never touch, and Chromium does not start under 24 GiB.
+  rlimit address_space{};
+  const bool limited =
+      getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur != address_space.rlim_max;
+  if (limited) {
+    const rlimit open{address_space.rlim_max, address_space.rlim_max};
+    setrlimit(RLIMIT_AS, &open);
+  }
   const int spawned =
       posix_spawn(&pid_, executable.c_str(), &actions, &attributes, argv.data(), environ);
+  if (limited) setrlimit(RLIMIT_AS, &address_space);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   close(child_in);
