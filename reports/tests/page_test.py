@@ -158,6 +158,36 @@ def main():
     expect(images and images.group(2) == "none", f"broken images: {images and images.group(2)}")
     expect('class="missing"' not in dom, "an image file the page wanted is missing")
 
+    # A case a supervised run's worker did not finish (issue 74): the run's results with one case as
+    # the report writes a crashed one (reports::unfinished_part and unfinished_entry), drawn again.
+    crashed = json.loads(json.dumps(results))
+    victim = crashed["matrix"]["cases"][0]
+    for k in ("accuracy", "counters", "time_ms", "time_samples_ms"):
+        victim.pop(k, None)
+    victim.update(verdict="crash", error="crash (SIGSEGV) after 0.4 s")
+    key = f'matrix/{victim["backend"]}/{victim["method"]}/{victim["scene"]}'
+    crashed["unfinished"] = [{"key": key, "stage": "matrix", "verdict": "crash",
+                              "error": "crash (SIGSEGV) after 0.4 s", "signal_name": "SIGSEGV",
+                              "stderr_tail": "drawing\nthe worker's last line\n"}]
+    crashed.pop("regression", None)
+    with open(os.path.join(out, "crashed.json"), "w") as f:
+        json.dump(crashed, f)
+    drawn = subprocess.run([sys.executable, os.path.join(HERE, "..", "make_report.py"), "-o",
+                            os.path.join(out, "crashed"), os.path.join(out, "crashed.json")],
+                           capture_output=True, text=True, timeout=240)
+    expect(drawn.returncode == 0, f"make_report.py on a crashed case: {drawn.stderr[-1500:]}")
+    if drawn.returncode == 0:
+        dom = dump_dom(browser, os.path.join(out, "crashed", "index.html"), os.path.join(out, "profile"))
+        expect('<div class="count crash"><b>1</b> crash</div>' in section(dom, "summary"),
+               "summary: the crashed case is not counted as a crash")
+        row = re.search(rf'<td data-cases="[^"]*\b{re.escape(victim["name"])}\b[^"]*">(.*?)</tr>',
+                        section(dom, "failures"), re.S)
+        expect(row and '<span class="verdict crash">crash</span>' in row.group(1)
+               and "SIGSEGV" in row.group(1), "failures: the crashed case's row has not its verdict and why")
+        unfinished = section(dom, "unfinished")
+        expect(f"<td>{key}</td>" in unfinished and "the worker's last line" in unfinished,
+               f"unfinished: {key} and its worker's last words are not listed")
+
     for f in failures:
         print("FAILED:", f)
     if not failures:
