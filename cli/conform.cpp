@@ -230,10 +230,9 @@ void add_conform(CLI::App& app) {
     const auto run_case = [&](const Case& c) {
       MarchParams params = o->params;
       params.method = c.method;
-      nlohmann::json record;
-      try {
+      return record_or_error([&] {
         const conformance::CaseResult r = suite.run(*c.backend, *c.scene, params, w, h);
-        record = conformance::to_json(r);
+        nlohmann::json record = conformance::to_json(r);
         record["table"] = table_lines(r);
         if (error_images) {
           const fs::path file =
@@ -244,21 +243,15 @@ void add_conform(CLI::App& app) {
               file);
           record["error_image"] = file.string();
         }
-      } catch (const std::bad_alloc&) {
-        throw;  // a worker answers out_of_memory
-      } catch (const std::exception& e) {
-        record = {{"backend", c.backend->name()},
-                  {"scene", c.scene->name},
-                  {"method", to_string(c.method)},
-                  {"error", e.what()}};
-      }
-      return record;
+        return record;
+      });
     };
     if (o->supervision.worker) {
       reports::serve_cases([&](const std::string& key) {
         for (const Case& c : held)
           if (c.key == key) return run_case(c);
-        throw std::invalid_argument("worker: no case " + key + " in this run");
+        // Its backend available where the run was planned but not in this process.
+        return nlohmann::json{{"error", "no such case here: its backend is unavailable in this worker"}};
       });
       return;
     }

@@ -321,26 +321,20 @@ void add_report(CLI::App& app) {
     // One case here: the part of the results it measures.
     const auto run_case = [&](const std::string& key) -> json {
       if (!backends) backends = reports::matrix_backends(r.matrix);
-      try {
+      return record_or_error([&]() -> json {
         json part = reports::run_report_part(
             scenes, r, [&](const std::string& k) { return k == key; }, {matrix_suite, sweep_suite},
             nullptr, &*backends, /*every_stage=*/false);
         // A case this process cannot run (its backend unavailable here, not where the run was
         // planned) says so, and why, rather than coming back empty.
         const std::vector<std::string> measured = reports::report_part_keys(part);
-        if (std::find(measured.begin(), measured.end(), key) == measured.end()) {
-          std::string why;
-          for (const json& skip : backends->skipped)
-            why +=
-                "; " + skip["backend"].get<std::string>() + " " + skip["reason"].get<std::string>();
-          return {{"error", "no such case here" + why}};
-        }
-        return part;
-      } catch (const std::bad_alloc&) {
-        throw;  // a worker answers out_of_memory
-      } catch (const std::exception& e) {
-        return {{"error", e.what()}};
-      }
+        if (std::find(measured.begin(), measured.end(), key) != measured.end()) return part;
+        std::string why;
+        for (const json& skip : backends->skipped)
+          why +=
+              "; " + skip["backend"].get<std::string>() + " " + skip["reason"].get<std::string>();
+        return {{"error", "no such case here" + why}};
+      });
     };
     if (o->supervision.worker) {
       reports::serve_cases(run_case);
@@ -378,8 +372,7 @@ void add_report(CLI::App& app) {
                      skip["reason"].get<std::string>().c_str());
     const auto show = [&](const std::string& key, const json& record) {
       const std::string stage = key.substr(0, key.find('/'));
-      const bool finished = !record.contains("verdict") && !record.contains("error");
-      if (!finished) {
+      if (unfinished_record(record)) {
         if (progress.reporter) progress.reporter->done();
         progress.reporter.reset();
         progress.stage.clear();
@@ -400,7 +393,7 @@ void add_report(CLI::App& app) {
     for (const RunCase& c : run.cases) {
       keys.push_back(c.key);
       const json& record = records.at(c.key);
-      if (!record.contains("verdict") && !record.contains("error")) {
+      if (!unfinished_record(record)) {
         parts.emplace_back(c.key, &record);
         continue;
       }

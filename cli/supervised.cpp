@@ -37,6 +37,20 @@ void add_supervision_options(CLI::App& cmd, SupervisionOptions& o, const std::st
   cmd.add_flag("--worker", o.worker)->group("");  // a worker of a supervised run (hidden)
 }
 
+nlohmann::json record_or_error(const std::function<nlohmann::json()>& run) {
+  try {
+    return run();
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    return {{"error", e.what()}};
+  }
+}
+
+bool unfinished_record(const nlohmann::json& record) {
+  return record.contains("verdict") || record.contains("error");
+}
+
 std::string record_verdict(const nlohmann::json& record) {
   if (record.contains("error") && !record.contains("verdict")) return "error";
   if (record.contains("verdict")) return record["verdict"].get<std::string>();

@@ -64,6 +64,14 @@ std::map<std::string, nlohmann::json> run_supervised(
 // lines its worker wrote on its standard error, indented; for a table.
 std::string unfinished_lines(const std::string& key, const nlohmann::json& record);
 
+// The record of a case run here by `run`: its own, or {"error": what} where it threw. A
+// std::bad_alloc passes on: a worker answers it out_of_memory (serve_cases).
+nlohmann::json record_or_error(const std::function<nlohmann::json()>& run);
+
+// Whether a record is of a case that did not finish: the supervisor's (crash, timeout,
+// out_of_memory) or an error. A report's or sweep's finished record is its part of the results.
+bool unfinished_record(const nlohmann::json& record);
+
 // A case record's verdict: pass, limit or fail (conformance's), crash, timeout or out_of_memory
 // (the supervisor's), or "error" (the case threw: {"error"}).
 std::string record_verdict(const nlohmann::json& record);

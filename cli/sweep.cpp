@@ -101,13 +101,7 @@ void add_sweep(CLI::App& app) {
     const auto run_group = [&](const std::string& key) -> json {
       reports::SweepOptions one = o->sweep;
       one.holds = [&](const std::string& k) { return k == key; };
-      try {
-        return reports::run_sweep(scenes, one, suite, nullptr);
-      } catch (const std::bad_alloc&) {
-        throw;  // a worker answers out_of_memory
-      } catch (const std::exception& e) {
-        return {{"error", e.what()}};
-      }
+      return record_or_error([&] { return reports::run_sweep(scenes, one, suite, nullptr); });
     };
     if (o->supervision.worker) {
       reports::serve_cases(run_group);
@@ -138,7 +132,7 @@ void add_sweep(CLI::App& app) {
     size_t done = 0;
     json unfinished = json::array();
     const auto show = [&](const std::string& key, const json& record) {
-      if (record.contains("verdict") || record.contains("error")) {
+      if (unfinished_record(record)) {
         std::fputs(("sweep: " + unfinished_lines(key, record)).c_str(), stderr);
         unfinished.push_back(reports::unfinished_entry(key, record));
       }
@@ -152,7 +146,7 @@ void add_sweep(CLI::App& app) {
     json points = json::array(), confirmations = json::array(), sweep_options;
     for (const RunCase& c : run.cases) {
       const json& part = records.at(c.key);
-      if (!part.contains("points")) continue;
+      if (unfinished_record(part)) continue;
       if (sweep_options.is_null()) sweep_options = part["options"];
       for (const json& p : part["points"]) points.push_back(p);
       for (const json& k : part["confirmations"]) confirmations.push_back(k);
