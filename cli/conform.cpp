@@ -251,7 +251,8 @@ void add_conform(CLI::App& app) {
         for (const Case& c : held)
           if (c.key == key) return run_case(c);
         // Its backend available where the run was planned but not in this process.
-        return nlohmann::json{{"error", "no such case here: its backend is unavailable in this worker"}};
+        return nlohmann::json{
+            {"error", "no such case here: its backend is unavailable in this worker"}};
       });
       return;
     }
