@@ -36,4 +36,22 @@ class DynamicLibrary {
 // The directory of the running program (/proc/self/exe), "" when it cannot be read.
 std::string program_directory();
 
+// Where flatmarch's files lie beside its program, found from the program's own folder and never
+// from the source tree: an installed PREFIX/bin/flatmarch has PREFIX/lib/flatmarch (the image
+// module) and PREFIX/share/flatmarch (the gallery, the report's script, the baseline); a build
+// tree has BUILD/lib/flatmarch and BUILD/share/flatmarch (links into the source), looked for
+// from every program's folder in it (BUILD/cli, BUILD/tests, BUILD/conformance/tests).
+struct InstallFolder {
+  const char* relative;     // "share/flatmarch"
+  const char* environment;  // "FLATMARCH_DATA_DIR": set, this folder and no other
+};
+inline constexpr InstallFolder kModuleFolder{"lib/flatmarch", "FLATMARCH_MODULE_DIR"};
+inline constexpr InstallFolder kDataFolder{"share/flatmarch", "FLATMARCH_DATA_DIR"};
+// The folder: its environment variable's, else the first of the program's folder's parent and
+// the two above it that holds `relative`; "" when none does.
+std::string install_folder(const InstallFolder& folder);
+// `file` in the data folder (kDataFolder), or, when there is none, the reason as an error
+// naming where it was looked for.
+std::string data_file(const std::string& file);
+
 }  // namespace flatmarch

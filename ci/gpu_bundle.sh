@@ -6,7 +6,8 @@
 # and Vulkan validation layer as .deb files (downloaded; amd64). No OpenImageIO: the report and
 # conform measure without it (images left out).
 #
-# Usage: ci/gpu_bundle.sh BUILD_DIR DEST        (e.g. ci/gpu_bundle.sh build-release .gpu)
+# Usage: ci/gpu_bundle.sh BUILD_DIR DEST        (a Release build with the tests and benchmarks:
+#   ci/build.sh build-gpu -DCMAKE_BUILD_TYPE=Release && ci/gpu_bundle.sh build-gpu .gpu)
 # Then, on the GPU machine, from the repository root with DEST carried:
 #   ci/gpu_check.sh --bundle DEST OUT_DIR [PEER_DIR]
 set -euo pipefail
@@ -28,6 +29,9 @@ for p in "${programs[@]}"; do
   mkdir -p "$stage/build/$(dirname "$p")"
   strip -o "$stage/build/$p" "$build/$p"
 done
+# The program finds its data beside its folder (build/share/flatmarch, links into the source
+# tree here: copied whole), as an installed one does.
+cp -rL "$build/share" "$stage/build/"
 mkdir -p "$stage/lib"
 for lib in $(ldd "$build/cli/flatmarch" "$build/bench/gpu_bench" | awk '/libtbb|libhwy|libbenchmark/ {print $3}' | sort -u); do
   cp -L "$lib" "$stage/lib/"

@@ -1,5 +1,7 @@
 #include "cli/common.hpp"
 
+#include "backends/dynamic_library.hpp"
+
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -348,6 +350,28 @@ Camera CameraOptions::apply(const Scene& scene) const {
   return c;
 }
 
+std::string data_folder(const std::string& sub) {
+  const std::string dir = install_folder(kDataFolder);
+  return dir.empty() ? sub : (std::filesystem::path(dir) / sub).string();
+}
+
+const char* const kSceneArgumentHelp = "Scene file (JSON), or a gallery scene's name (torus)";
+
+std::string named_scene_file(const std::string& file_or_name) {
+  namespace fs = std::filesystem;
+  const bool name = file_or_name.find('/') == std::string::npos &&
+                    fs::path(file_or_name).extension() != ".json" && !fs::exists(file_or_name);
+  if (!name) return file_or_name;
+  const fs::path in = fs::path(data_folder("scenes")) / (file_or_name + ".json");
+  if (fs::exists(in)) return in.string();
+  throw UsageError("SCENE: no scene file \"" + file_or_name + "\", nor a scene of that name in " +
+                   "the gallery (" + data_folder("scenes") + ")");
+}
+
+Scene load_named_scene(const std::string& file_or_name) {
+  return load_scene(named_scene_file(file_or_name));
+}
+
 namespace {
 
 // A scene named by a file, or by its name in one of the gallery folders.
@@ -395,8 +419,13 @@ std::string image_module_missing() {
 }
 
 void say_left_out(const std::string& command, const std::string& what, const std::string& how) {
-  std::string why = image_module_missing();
-  for (size_t at; (at = why.find("\n  ")) != std::string::npos;) why.replace(at, 3, " ");
+  // The reason on one line: its "\n  " breaks as spaces.
+  std::string why;
+  for (const char c : image_module_missing())
+    if (c == '\n')
+      why += ' ';
+    else if (c != ' ' || why.empty() || why.back() != ' ')
+      why += c;
   std::fflush(stdout);  // after what the command printed, not amid it
   std::fprintf(stderr, "%s: left out, %s: no image library here (%s). %s\n", command.c_str(),
                what.c_str(), why.c_str(), how.c_str());

@@ -65,6 +65,18 @@ MemoryLimit memory_limit();
 void check_frame_memory(const std::string& option, int w, int h, int frames,
                         const std::string& work);
 
+// A folder of flatmarch's installed data (share/flatmarch beside the program's folder,
+// dynamic_library.hpp): "scenes" (the gallery), "conformance/scenes"; the same relative to here
+// when the program has no data folder beside it.
+std::string data_folder(const std::string& sub);
+// A scene given as a file, or by its name in the gallery (data_folder("scenes")): `flatmarch
+// render torus` from anywhere. A name found nowhere is the file's error, with the gallery named.
+Scene load_named_scene(const std::string& file_or_name);
+// The file load_named_scene reads.
+std::string named_scene_file(const std::string& file_or_name);
+// The help text of a SCENE argument that load_named_scene reads.
+extern const char* const kSceneArgumentHelp;
+
 // The scenes named by --scene (a file, or a scene's name in one of the --gallery folders) or,
 // when none is named, every scene of the folders, each folder's sorted by file name. UsageError
 // when a name is found nowhere or the folders hold no scene.

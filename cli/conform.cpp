@@ -85,7 +85,7 @@ void add_conform(CLI::App& app) {
       "traces probe rays diverged / traced; failures the rays of each class.");
   struct Options {
     std::vector<std::string> backends, scenes, methods;
-    std::vector<std::string> galleries = {"scenes", "conformance/scenes"};
+    std::vector<std::string> galleries = {data_folder("scenes"), data_folder("conformance/scenes")};
     std::string size = "160x90", json = "conform.json", thresholds, error_images;
     std::string precision = "f32";
     MarchParams params;
@@ -265,7 +265,8 @@ void add_conform(CLI::App& app) {
                              .fingerprint = out["fingerprint"],
                              .options = out["options"],
                              .cases = {},
-                             .quiet = o->quiet};
+                             .quiet = o->quiet,
+                             .resumed = {}};
     if (shard) supervised.options["shard"] = plan.record;
     std::map<std::string, const Case*> by_key;
     for (const Case& c : held) {

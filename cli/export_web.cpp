@@ -76,7 +76,7 @@ void add_export_web(CLI::App& app) {
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("SCENE", o->scenes, "Scene files (JSON)")->required();
+  cmd->add_option("SCENE", o->scenes, "Scene files (JSON), or gallery scenes' names")->required();
   cmd->add_option("-o,--output", o->out, "Output folder")->required();
   cmd->add_option("--method", o->method, "The method the page starts with")->capture_default_str();
   add_march_param_options(*cmd, o->params);
@@ -89,7 +89,7 @@ void add_export_web(CLI::App& app) {
     o->params.method = methods[0];
     std::vector<Scene> scenes;
     for (const std::string& file : o->scenes) {
-      scenes.push_back(load_scene(file));
+      scenes.push_back(load_named_scene(file));
       check_reach(scenes.back(), scenes.back().camera, o->params);
     }
     const fs::path out(o->out);

@@ -24,7 +24,7 @@ void add_gallery(CLI::App& app) {
       "picture),\n"
       "and an index.html that shows them all with their derived structure.");
   struct Options {
-    std::string scenes = "scenes", out = "out/gallery", size = "960x540";
+    std::string scenes = data_folder("scenes"), out = "out/gallery", size = "960x540";
     bool quiet = false;
     MarchOptions march;
   };

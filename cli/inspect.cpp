@@ -13,10 +13,10 @@ void add_inspect(CLI::App& app) {
       "their type, vertex classes with cone angles, Euler characteristic, orientability, genus.");
   auto file = std::make_shared<std::string>();
   auto compact = std::make_shared<bool>(false);
-  cmd->add_option("SCENE", *file, "Scene file (JSON)")->required();
+  cmd->add_option("SCENE", *file, kSceneArgumentHelp)->required();
   cmd->add_flag("--compact", *compact, "One line of JSON instead of indented");
   cmd->callback([file, compact] {
-    const Scene scene = load_scene(*file);
+    const Scene scene = load_named_scene(*file);
     std::cout << inspect(scene).dump(*compact ? -1 : 2) << "\n";
   });
 }

@@ -191,8 +191,8 @@ void add_merge(CLI::App& app) {
       "backends.");
   struct Options {
     std::vector<std::string> files;
-    // The run's scenes, named in its results: here, else in the source tree's gallery.
-    std::vector<std::string> galleries = {"scenes", FLATMARCH_SOURCE_DIR "/scenes"};
+    // The run's scenes, named in its results: in the gallery.
+    std::vector<std::string> galleries = {data_folder("scenes")};
     std::string out, baseline, python = default_python();
     bool no_html = false;
   };

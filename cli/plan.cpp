@@ -25,7 +25,7 @@ void add_plan(CLI::App& app) {
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("SCENE", o->scene, "Scene file (JSON)")->required();
+  cmd->add_option("SCENE", o->scene, kSceneArgumentHelp)->required();
   cmd->add_option("-o,--output", o->out, "Output SVG")->required();
   auto* from = cmd->add_option("--from", o->from,
                                "Start of a light ray X,Y,Z in the coordinates of --polygon");
@@ -42,7 +42,7 @@ void add_plan(CLI::App& app) {
       throw UsageError("--max-events: must lie in [1, 100000]");
     if (!(o->width >= 100.0 && o->width <= 20000.0))
       throw UsageError("--width: must lie in [100, 20000]");
-    const Scene scene = load_scene(o->scene);
+    const Scene scene = load_named_scene(o->scene);
     PlanOptions options;
     options.width = o->width;
     options.max_events = o->max_events;

@@ -20,7 +20,7 @@ void add_render(CLI::App& app) {
     CameraOptions camera;
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("SCENE", o->scene, "Scene file (JSON)")->required();
+  cmd->add_option("SCENE", o->scene, kSceneArgumentHelp)->required();
   cmd->add_option("-o,--output", o->out, "Output PNG; the EXR goes beside it")->required();
   cmd->add_option("--size", o->size, "Image size WxH")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No progress or summary on stderr");
@@ -36,7 +36,7 @@ void add_render(CLI::App& app) {
     const auto [w, h] = parse_size("--size", o->size);
     check_frame_memory("--size", w, h, kRenderFrames, "a rendered image");
     const Backend& backend = o->march.resolve();
-    const Scene scene = load_scene(o->scene);
+    const Scene scene = load_named_scene(o->scene);
     const Camera camera = o->camera.apply(scene);
     warn_about_resolution(scene, o->march.params);
     check_reach(scene, camera, o->march.params);

@@ -27,7 +27,7 @@ void add_shader(CLI::App& app) {
     bool trace = false, compile = false;
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("SCENE", o->scene, "Scene file (JSON)")->required();
+  cmd->add_option("SCENE", o->scene, kSceneArgumentHelp)->required();
   cmd->add_option("-o,--output", o->out, "Write the source here instead of to stdout");
   cmd->add_flag("--trace", o->trace, "The variant that traces one probe ray (its events)");
   cmd->add_option("--backend", o->backend,
@@ -45,7 +45,7 @@ void add_shader(CLI::App& app) {
                   "generated one")
       ->check(CLI::ExistingFile);
   cmd->callback([o] {
-    const Scene scene = load_scene(o->scene);
+    const Scene scene = load_named_scene(o->scene);
     MarchParams params;
     params.method = Method::analytic;
     if (o->backend != "opengl" && o->backend != "vulkan")

@@ -30,7 +30,7 @@ void add_sweep(CLI::App& app) {
       "front and the recommended eps and offset; writes everything as JSON.");
   struct Options {
     std::vector<std::string> scenes, methods, precisions;
-    std::vector<std::string> galleries = {"scenes"};
+    std::vector<std::string> galleries = {data_folder("scenes")};
     std::string size = "64x36", json = "sweep.json", shard;
     reports::SweepOptions sweep;
     SupervisionOptions supervision;
@@ -125,7 +125,8 @@ void add_sweep(CLI::App& app) {
                       .fingerprint = reports::hardware_fingerprint(),
                       .options = options,
                       .cases = {},
-                      .quiet = o->quiet};
+                      .quiet = o->quiet,
+                      .resumed = {}};
     for (const auto& [key, cost] : groups)
       if (!plan || plan->holds(key)) run.cases.push_back({key, cost});
     ProgressReporter progress("sweep", o->quiet);

@@ -20,7 +20,7 @@ void add_trace(CLI::App& app) {
     MarchOptions march;
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("SCENE", o->scene, "Scene file (JSON)")->required();
+  cmd->add_option("SCENE", o->scene, kSceneArgumentHelp)->required();
   cmd->add_option("--from", o->from, "Ray origin X,Y,Z in the coordinates of --polygon")
       ->required();
   cmd->add_option("--dir", o->dir, "Ray direction DX,DY,DZ (normalised)")->required();
@@ -31,7 +31,7 @@ void add_trace(CLI::App& app) {
     if (o->max_events < 1 || o->max_events > 10'000'000)
       throw UsageError("--max-events: must lie in [1, 1e7]");
     const Backend& backend = o->march.resolve();
-    const Scene scene = load_scene(o->scene);
+    const Scene scene = load_named_scene(o->scene);
     Ray ray{o->polygon, parse_vec3("--from", o->from), parse_vec3("--dir", o->dir)};
     if (auto problem = ray_problem(scene, ray))
       throw UsageError("--from/--dir/--polygon: " + *problem);

@@ -36,7 +36,7 @@ void add_view(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("SCENE", o->scene,
-                  "Scene file (JSON); default scenes/l_shape.json in the current directory");
+                  "Scene file (JSON), or a gallery scene's name; default l_shape");
   cmd->add_option("--size", o->size, "Window size WxH")->capture_default_str();
   cmd->add_option("--scale", o->scale,
                   "Rendered resolution as a fraction of the window's, in (0, 1]; keys - and =")
@@ -79,13 +79,7 @@ void add_view(CLI::App& app) {
     if (o->frames < 0) throw UsageError("--frames: must be 0 or more");
     if (!std::filesystem::is_directory(o->screenshot_dir))
       throw UsageError("--screenshot-dir: " + o->screenshot_dir + " is not a folder");
-    if (o->scene.empty()) {
-      o->scene = "scenes/l_shape.json";
-      if (!std::filesystem::exists(o->scene))
-        throw UsageError(
-            "no SCENE given and there is no scenes/l_shape.json in the current directory: name "
-            "a scene file (flatmarch view SCENE.json)");
-    }
+    o->scene = named_scene_file(o->scene.empty() ? "l_shape" : o->scene);
     if (!o->script.empty()) {
       try {
         v.script = viewer::load_script(o->script);

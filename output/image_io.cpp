@@ -18,12 +18,13 @@ namespace {
 // Where the module may be, in the order tried.
 std::vector<std::string> module_paths() {
   std::vector<std::string> paths;
-  // Set, the folder is the only place looked in: a test makes the module unloadable so.
-  if (const char* dir = std::getenv("FLATMARCH_MODULE_DIR"); dir != nullptr && *dir != '\0')
-    return {std::string(dir) + "/flatmarch_image.so"};
-  paths.push_back(std::string(FLATMARCH_MODULE_DIR) + "/flatmarch_image.so");
-  if (const std::string dir = program_directory(); !dir.empty())
-    paths.push_back(dir + "/../lib/flatmarch_image.so");
+  // $FLATMARCH_MODULE_DIR set, it is the only place looked in: a test makes the module
+  // unloadable so.
+  if (const std::string dir = install_folder(kModuleFolder); !dir.empty())
+    paths.push_back(dir + "/flatmarch_image.so");
+  else
+    paths.push_back(std::string(kModuleFolder.relative) +
+                    "/flatmarch_image.so beside the program's folder");
   return paths;
 }
 

@@ -35,8 +35,8 @@ struct ImageLibrary {
 // Changes whenever ImageLibrary or a type it passes changes.
 constexpr int kImageLibraryAbi = 3;
 
-// The module, loaded on first call from FLATMARCH_MODULE_DIR (environment: there alone, where it
-// is set), else the build's module folder or ../lib beside the program; throws
+// The module, loaded on first call from $FLATMARCH_MODULE_DIR (there alone, where it is set),
+// else lib/flatmarch beside the program's folder (dynamic_library.hpp's kModuleFolder); throws
 // std::runtime_error saying where it looked and why it could not load.
 const ImageLibrary& image_library();
 // The same, or null where it cannot be loaded, with the reason in `why` (when given): for work
