@@ -391,7 +391,9 @@ def ranking_section(results):
     for b in results.get("ranking", []):
         row = [b["rank"], b["backend"], device_text(b), mrays(b["rays_per_s"]),
                f'{b["passed"]}/{b["cases"]} pass' + (f', {b["limits"]} limit' if b.get("limits") else "")
-               + (f', {b["errors"]} errors' if b["errors"] else "")]
+               + (f', {b["errors"]} errors' if b["errors"] else "")
+               + (f'; a sample: {b["sampled"]["scenes"]} of {b["sampled"]["of_scenes"]} scenes'
+                  if b.get("sampled") else "")]
         for m in methods:
             mm = b["methods"].get(m)
             peak = f', {pct(mm["of_peak"])} of peak' if mm and "of_peak" in mm else ""
@@ -414,6 +416,10 @@ def ranking_section(results):
     skipped = results.get("matrix", {}).get("skipped", [])
     if skipped:
         parts.append("<p>Skipped: " + "; ".join(f'{esc(s["backend"])} ({esc(s["reason"])})' for s in skipped) + "</p>")
+    for s in results.get("matrix", {}).get("sampled", []):
+        parts.append(f'<p class="sampled">Measured on a sample: {esc(s["backend"])}, on '
+                     f'{len(s["scenes"])} of {s["of_scenes"]} scenes ({esc(", ".join(s["scenes"]))}), '
+                     f'because {esc(s["why"])}. Its figures are of those scenes alone.</p>')
     return "\n".join(parts)
 
 

@@ -332,12 +332,23 @@ MatrixBackends matrix_backends(const MatrixOptions& o) {
   return out;
 }
 
+bool matrix_measures(const MatrixOptions& o, const std::string& backend, const std::string& scene) {
+  const auto has = [](const std::vector<std::string>& v, const std::string& x) {
+    return std::find(v.begin(), v.end(), x) != v.end();
+  };
+  return !has(o.sampled_backends, backend) || has(o.sample_scenes, scene);
+}
+
 std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
-                                                         const MatrixOptions& o) {
+                                                         const MatrixOptions& o,
+                                                         const MatrixBackends* built) {
+  std::optional<MatrixBackends> own;
+  if (!built) own = matrix_backends(o);
   std::vector<std::pair<std::string, double>> cases;
-  for (const auto& backend : matrix_backends(o).available)
+  for (const auto& backend : (built ? *built : *own).available)
     for (const Scene& scene : scenes)
       for (const Method m : o.methods) {
+        if (!matrix_measures(o, backend->name(), scene.name)) continue;
         const std::string method = to_string(m);
         double cost = 0.0;
         if (o.conformance)
@@ -346,7 +357,8 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
         if (o.timing)
           cost += timed_case_cost(frame_cost(backend->name(), method, o.width, o.height),
                                   o.repetitions, o.min_time);
-        cases.emplace_back(matrix_case_key(backend->name(), to_string(m), scene.name), cost);
+        cases.emplace_back(matrix_case_key(backend->name(), to_string(m), scene.name),
+                           cost * scene_cost_factor(scene));
       }
   return cases;
 }
@@ -364,8 +376,16 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
           skip["backend"].get<std::string>() + " skipped: " + skip["reason"].get<std::string>(), 0,
           0);
   const auto held = [&](const Backend& backend, Method m, const Scene& scene) {
-    return !o.holds || o.holds(matrix_case_key(backend.name(), to_string(m), scene.name));
+    return matrix_measures(o, backend.name(), scene.name) &&
+           (!o.holds || o.holds(matrix_case_key(backend.name(), to_string(m), scene.name)));
   };
+  for (const std::string& b : o.sampled_backends) {
+    if (!out.contains("sampled")) out["sampled"] = json::array();
+    out["sampled"].push_back({{"backend", b},
+                              {"scenes", o.sample_scenes},
+                              {"of_scenes", scenes.size()},
+                              {"why", o.sample_why}});
+  }
   int total = 0;
   for (const auto& backend : backends)
     for (const Scene& scene : scenes)

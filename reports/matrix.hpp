@@ -35,16 +35,19 @@ struct MatrixOptions {
   std::filesystem::path images;
   // The cases to run, by matrix_case_key (a shard's, issue 24); empty: every case.
   std::function<bool(const std::string& key)> holds;
+  // Backends measured on a sample of the scenes, not all: one whose cases take many times the
+  // others' (a browser drawing in software). `sample_scenes` names the scenes, `sample_why` says
+  // why, as the results, the ranking and the page repeat it.
+  std::vector<std::string> sampled_backends, sample_scenes;
+  std::string sample_why;
 };
+
+// Whether the matrix measures `backend` on `scene` (every scene but for a sampled backend).
+bool matrix_measures(const MatrixOptions& o, const std::string& backend, const std::string& scene);
 
 // A matrix case's key in a sharded run's case list: "matrix/BACKEND/METHOD/SCENE".
 std::string matrix_case_key(const std::string& backend, const std::string& method,
                             const std::string& scene);
-
-// The matrix's cases (backends available here x scenes x methods, in run_matrix's order) by key,
-// each with its expected seconds on this machine (conformance and timing).
-std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
-                                                         const MatrixOptions& options);
 
 // Called with a line of progress: what was done, how many of how many.
 using MatrixProgress = std::function<void(const std::string& line, int done, int total)>;
@@ -68,6 +71,14 @@ struct MatrixBackends {
   nlohmann::json skipped = nlohmann::json::array();
 };
 MatrixBackends matrix_backends(const MatrixOptions& options);
+
+// The matrix's cases (backends available here x scenes x methods, in run_matrix's order) by key,
+// each with its expected seconds on this machine (conformance and timing). The backends are
+// `built`'s, or made (matrix_backends) where null: making them starts a browser, GL and Vulkan
+// contexts, seconds on a machine without a GPU, which a worker's every case must not pay.
+std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
+                                                         const MatrixOptions& options,
+                                                         const MatrixBackends* built = nullptr);
 
 // Runs the matrix (on `backends`, or on matrix_backends(options) where null). Returns
 // {"benchmarks": Google Benchmark's JSON document (each GPU case's run labelled with its device),

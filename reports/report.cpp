@@ -11,6 +11,7 @@
 
 #include "reports/fingerprint.hpp"
 #include "reports/gallery.hpp"
+#include "reports/shard.hpp"
 #include "reports/supervise.hpp"
 #include "reports/surfaces.hpp"
 
@@ -35,22 +36,46 @@ std::string number(double v) {
 
 }  // namespace
 
+std::vector<std::string> first_of_each_surface_type(const std::vector<Scene>& scenes) {
+  std::vector<std::string> chosen;
+  std::set<std::string> types;
+  for (const Scene& s : scenes)
+    if (types.insert(surface_type(s)).second) chosen.push_back(s.name);
+  return chosen;
+}
+
+std::vector<std::string> simplest_of_each_surface_type(const std::vector<Scene>& scenes) {
+  std::vector<std::string> types;
+  std::map<std::string, const Scene*> simplest;
+  for (const Scene& s : scenes) {
+    const std::string type = surface_type(s);
+    auto [it, fresh] = simplest.emplace(type, &s);
+    if (fresh) types.push_back(type);
+    if (!fresh && edge_count(s) < edge_count(*it->second)) it->second = &s;
+  }
+  std::vector<std::string> chosen;
+  for (const std::string& type : types) chosen.push_back(simplest[type]->name);
+  return chosen;
+}
+
 namespace {
 
 // The scenes the sweep runs on: every scene, or the first of each surface type.
 std::vector<Scene> sweep_scenes(const std::vector<Scene>& scenes, const ReportOptions& o) {
+  if (o.sweep_all_scenes) return scenes;
+  const std::vector<std::string> first = first_of_each_surface_type(scenes);
   std::vector<Scene> chosen;
-  std::set<std::string> types;
   for (const Scene& s : scenes)
-    if (o.sweep_all_scenes || types.insert(surface_type(s)).second) chosen.push_back(s);
+    if (std::find(first.begin(), first.end(), s.name) != first.end()) chosen.push_back(s);
   return chosen;
 }
 
 }  // namespace
 
 std::vector<std::pair<std::string, double>> report_cases(const std::vector<Scene>& scenes,
-                                                         const ReportOptions& o) {
-  std::vector<std::pair<std::string, double>> cases = matrix_cases(scenes, o.matrix);
+                                                         const ReportOptions& o,
+                                                         const MatrixBackends* backends) {
+  std::vector<std::pair<std::string, double>> cases = matrix_cases(scenes, o.matrix, backends);
   if (o.sweep_enabled)
     for (auto& c : sweep_cases(sweep_scenes(scenes, o), o.sweep)) cases.push_back(std::move(c));
   if (o.scaling_enabled)
@@ -104,7 +129,7 @@ json run_report_part(const std::vector<Scene>& scenes, const ReportOptions& o,
   json part = {{"seconds", json::object()}};
   MatrixOptions matrix = o.matrix;
   matrix.holds = holds;
-  if (holds_any(matrix_cases(scenes, o.matrix))) {
+  if (holds_any(matrix_cases(scenes, o.matrix, backends))) {
     part["matrix"] = run_matrix(
         scenes, matrix, suites.matrix,
         [&](const std::string& line, int done, int total) {
@@ -348,6 +373,13 @@ json rank_backends(const json& matrix) {
                                        {"rest_share", t.shares[2] / n}};
     }
   }
+  // A backend measured on a sample of the scenes: its figures are of those scenes alone.
+  for (const json& sample : matrix.value("sampled", json::array()))
+    for (json& b : ranking)
+      if (b["backend"] == sample["backend"])
+        b["sampled"] = {{"scenes", sample["scenes"].size()},
+                        {"of_scenes", sample["of_scenes"]},
+                        {"why", sample["why"]}};
   std::stable_sort(ranking.begin(), ranking.end(), [](const json& a, const json& b) {
     const bool ca = a["passed"] == a["cases"], cb = b["passed"] == b["cases"];
     if (ca != cb) return ca;
@@ -476,6 +508,9 @@ std::string describe_selection(const json& results, const std::string& type) {
     for (const auto& [verdict, n] : unfinished.items())
       ended += (ended.empty() ? "" : ", ") + std::to_string(n.get<int>()) + " " + verdict;
     if (!ended.empty()) s += " (" + ended + ")";
+    if (b.contains("sampled"))
+      s += " on a sample of " + std::to_string(b["sampled"]["scenes"].get<int>()) + " of " +
+           std::to_string(b["sampled"]["of_scenes"].get<int>()) + " scenes";
     if (b.contains("device"))
       s += "  on " + b["device"]["name"].get<std::string>() +
            (b["device"]["software"].get<bool>() ? " (software: a rasteriser on the CPU)" : "") +
@@ -732,12 +767,15 @@ json assemble_report(const json& header,
   json benchmarks = json::array(), context = json::object(), scaling_benchmarks = json::array();
   json points = json::array(), confirmations = json::array(), series = json::array();
   json sweep_options, seconds = json::object();
-  json matrix_skipped = json::array(), scaling_skipped;
+  json matrix_skipped = json::array(), matrix_sampled, scaling_skipped;
   bool matrix_seen = false;
   std::string sweep_from;
   for (const auto& [label, doc] : parts) {
     if (doc->contains("matrix")) {
-      if (!matrix_seen) matrix_skipped = (*doc)["matrix"].value("skipped", json::array());
+      if (!matrix_seen) {
+        matrix_skipped = (*doc)["matrix"].value("skipped", json::array());
+        matrix_sampled = (*doc)["matrix"].value("sampled", json());
+      }
       matrix_seen = true;
       for (const json& c : (*doc)["matrix"].at("cases"))
         matrix[matrix_case_key(c["backend"], c["method"], c["scene"])] = c;
@@ -773,6 +811,7 @@ json assemble_report(const json& header,
   out["matrix"] = {{"cases", json::array()},
                    {"skipped", matrix_skipped},
                    {"benchmarks", {{"context", context}, {"benchmarks", benchmarks}}}};
+  if (!matrix_sampled.is_null()) out["matrix"]["sampled"] = matrix_sampled;
   for (const std::string& key : keys)
     if (matrix.count(key)) out["matrix"]["cases"].push_back(matrix[key]);
   if (!sweep_options.is_null())

@@ -32,8 +32,19 @@ struct ReportOptions {
 
 // The report's cases by key (matrix_case_key, sweep_case_key, scaling_case_key), each with its
 // expected seconds on this machine: what a shard holds, and its estimate before it starts.
+// The names of the first scene of each surface type (surfaces.hpp), in the scenes' order: the
+// sweep's scenes.
+std::vector<std::string> first_of_each_surface_type(const std::vector<Scene>& scenes);
+// The names of the scene of each surface type with the fewest edges (the first of those), in
+// the order of the types' first scenes: those a sampled backend (MatrixOptions::sampled_backends)
+// is measured on, the cheapest of each kind of room.
+std::vector<std::string> simplest_of_each_surface_type(const std::vector<Scene>& scenes);
+
+// The report's cases, (key, expected seconds), in its order: the matrix's (on `backends`, or on
+// backends made here where null: matrix_cases), the sweep's groups, the scaling series.
 std::vector<std::pair<std::string, double>> report_cases(const std::vector<Scene>& scenes,
-                                                         const ReportOptions& options);
+                                                         const ReportOptions& options,
+                                                         const MatrixBackends* backends = nullptr);
 
 using ReportProgress =
     std::function<void(const std::string& stage, const std::string& line, int done, int total)>;

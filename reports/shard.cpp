@@ -1,4 +1,5 @@
 #include "reports/shard.hpp"
+#include "reports/surfaces.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -60,6 +61,10 @@ int edge_count(const Scene& scene) {
   int edges = 0;
   for (const Polygon& polygon : scene.polygons) edges += static_cast<int>(polygon.size());
   return edges;
+}
+
+double scene_cost_factor(const Scene& scene) {
+  return surface_type(scene) == "prism" ? 5.0 : 1.0;
 }
 
 double conformance_case_cost(const std::string& backend, const std::string& method, int edges,

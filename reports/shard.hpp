@@ -45,6 +45,10 @@ double timed_case_cost(double frame_seconds, int repetitions, double min_time);
 
 // The number of edges of a scene's polygons: the oracle's cost grows with it.
 int edge_count(const Scene& scene);
+// How many times a gallery scene of its kind a case of `scene` takes: a prism's rays march in 3D,
+// through floors and ceilings, and took 2-15x the time of a flat scene's case (the default
+// report's matrix, per scene and backend, on a 2-core Zen 5): 5; else 1.
+double scene_cost_factor(const Scene& scene);
 
 // What a shard's results carry so that merge() can check they belong together: the shard, the
 // whole run's case list (names, in order), and the cost of each shard's cases.

@@ -104,7 +104,7 @@ std::vector<std::pair<std::string, double>> sweep_cases(const std::vector<Scene>
         // Two rounds of re-checks at the larger size, as a rule.
         const double recheck = conformance_case_cost(
             o.backend, method, edges, o.width * o.confirm_scale, o.height * o.confirm_scale);
-        cost += static_cast<double>(precisions) *
+        cost += scene_cost_factor(s) * static_cast<double>(precisions) *
                 (static_cast<double>(grid) * point + (o.confirm_scale > 1 ? 2.0 * recheck : 0.0));
       }
       cases.emplace_back(sweep_case_key(type, to_string(m)), cost);

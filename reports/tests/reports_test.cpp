@@ -270,6 +270,36 @@ TEST(Ranking, ConformingBackendsFirstThenBySpeed) {
   EXPECT_TRUE(rec["parameters"].empty());  // no sweep: select falls back to the defaults
 }
 
+// A backend measured on a sample of the scenes (a browser drawing in software) is ranked with
+// the sample named: in the ranking and in the lines the report prints.
+TEST(Ranking, ASampledBackendSaysOnHowManyScenes) {
+  json cases = json::array();
+  for (const std::string scene : {"x", "y", "z"}) {
+    cases.push_back(matrix_case("cpu", "analytic", scene, 2e6, true, 3));
+    if (scene == "x") cases.push_back(matrix_case("browser", "analytic", scene, 1e5, true, 3));
+  }
+  const json matrix = {
+      {"cases", cases},
+      {"sampled",
+       {{{"backend", "browser"}, {"scenes", {"x"}}, {"of_scenes", 3}, {"why", "slow"}}}}};
+  const json ranking = rank_backends(matrix);
+  ASSERT_EQ(ranking.size(), 2u);
+  EXPECT_EQ(ranking[1]["backend"], "browser");
+  EXPECT_EQ(ranking[1]["sampled"]["scenes"], 1);
+  EXPECT_EQ(ranking[1]["sampled"]["of_scenes"], 3);
+  EXPECT_FALSE(ranking[0].contains("sampled"));
+  const json results = {{"recommendation", recommend(ranking, json::object())},
+                        {"ranking", ranking},
+                        {"fingerprint",
+                         {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
+                          {"vulkan", json::object()},
+                          {"opengl", json::object()}}}};
+  const std::string text = describe_selection(results, "");
+  EXPECT_NE(text.find("1/1 cases pass, 0 at their method's limit on a sample of 1 of 3 scenes"),
+            std::string::npos)
+      << text;
+}
+
 // When no backend passes every case, the recommendation does not say it does.
 TEST(Ranking, ARecommendationWithoutAConformingBackendSaysSo) {
   json cases = json::array();
