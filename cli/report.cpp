@@ -8,6 +8,8 @@
 #include <map>
 #include <optional>
 
+#include "backends/dynamic_library.hpp"
+#include "cli/case_progress.hpp"
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "cli/supervised.hpp"
@@ -36,9 +38,8 @@ std::string quoted(const std::string& word) {
 
 void make_report_page(const std::string& python, const std::vector<std::string>& results,
                       const fs::path& out, const std::string& previous) {
-  std::string command = quoted(python) + " " +
-                        quoted(FLATMARCH_SOURCE_DIR "/reports/make_report.py") + " -o " +
-                        quoted(out.string());
+  std::string command = quoted(python) + " " + quoted(data_file("reports/make_report.py")) +
+                        " -o " + quoted(out.string());
   if (!previous.empty()) command += " --previous " + quoted(previous);
   for (const std::string& r : results) command += " " + quoted(r);
   if (std::system(command.c_str()) != 0)
@@ -50,26 +51,6 @@ void make_report_page(const std::string& python, const std::vector<std::string>&
 }
 
 namespace {
-
-// Progress of the report's stages on stderr, one reporter per stage.
-struct StageProgress {
-  bool quiet;
-  std::string stage;
-  std::unique_ptr<ProgressReporter> reporter;
-  void operator()(const std::string& s, const std::string& line, int done, int total) {
-    // What a shard holds and its estimated time, before it starts: said even when quiet, as
-    // the first line of a scheduler's log.
-    if (s == "shard") std::fprintf(stderr, "report: %s\n", line.c_str());
-    if (quiet || s == "shard") return;
-    if (s != stage) {
-      if (reporter) reporter->done();
-      stage = s;
-      reporter = std::make_unique<ProgressReporter>("report: " + s);
-    }
-    if (total == 0) std::fprintf(stderr, "report: %s\n", line.c_str());
-    if (total > 0) (*reporter)(static_cast<double>(done) / total);
-  }
-};
 
 // Throws a UsageError unless `file` is a results file of `flatmarch report`.
 void check_results_file(const std::string& option, const std::string& file) {
@@ -83,7 +64,7 @@ void check_results_file(const std::string& option, const std::string& file) {
 }  // namespace
 
 json regression_section(const json& results, const std::string& given) {
-  const std::string file = given.empty() ? FLATMARCH_SOURCE_DIR "/reports/baseline.json" : given;
+  const std::string file = given.empty() ? data_folder("reports/baseline.json") : given;
   if (given.empty() && !fs::exists(file))
     return {{"checked", false}, {"why", file + " is not there"}};
   const json baseline = read_json("--baseline", file);
@@ -136,9 +117,10 @@ void add_report(CLI::App& app) {
       "the ranking of backends and recommended parameters, the recommended method's images with\n"
       "their differences from the oracle, gallery images per backend, speed against accuracy,\n"
       "the ambiguous share, stability and step heatmaps, scaling curves, definitions. The quick\n"
-      "default takes about five minutes on 2 cores, and ten more where the webgl backend's\n"
-      "browser draws in software (SwiftShader; --skip-backend webgl leaves it out); --full\n"
-      "measures more. Given result files (RESULTS...), measures nothing: one file makes its\n"
+      "default takes minutes on 2 cores; where the webgl backend's browser draws in software\n"
+      "(SwiftShader) it is measured on one scene of each surface type (--all-scenes: on all;\n"
+      "--skip-backend webgl leaves it out); --full measures more. Given result files (RESULTS...), "
+      "measures nothing: one file makes its\n"
       "page again, several compare their machines. --baseline checks the deterministic\n"
       "figures (steps, crossings, conformance rates) against committed ones: exit 1 when one\n"
       "regresses beyond its tolerance; slower timings only warn. Without it the page shows the\n"
@@ -146,12 +128,14 @@ void add_report(CLI::App& app) {
       "not. --previous adds the change per case since an earlier run.");
   struct Options {
     std::vector<std::string> results, backends, skip_backends, scenes, methods;
-    std::vector<std::string> galleries = {"scenes"};
-    std::string out = "reports/out", size, conform_size = "160x90", sweep_size, sweep_backend;
+    std::vector<std::string> galleries = {data_folder("scenes")};
+    std::string out = "reports/out", progress_log, size, conform_size = "160x90", sweep_size,
+                sweep_backend;
     std::string baseline, write_baseline, previous, shard, python = default_python();
     int repetitions = 0;
     double min_time = 0.02;
-    bool full = false, no_sweep = false, no_scaling = false, no_html = false, quiet = false;
+    bool full = false, all_scenes = false, no_sweep = false, no_scaling = false, no_html = false,
+         quiet = false;
     MarchParams params;
     BackendOptions backend_options;
     SupervisionOptions supervision;
@@ -164,6 +148,9 @@ void add_report(CLI::App& app) {
   cmd->add_flag("--full", o->full,
                 "The full matrix: frames 640x360, 5 repetitions, the sweep on every scene, longer "
                 "scaling series on every backend");
+  cmd->add_flag("--all-scenes", o->all_scenes,
+                "Measure a browser that draws in software (the webgl backend on SwiftShader) on "
+                "every scene too (default: one scene of each surface type; --full implies it)");
   cmd->add_option("--backend", o->backends,
                   "Backend to measure (repeat; default: " + joined(kernel_backend_names()) +
                       " — those unavailable here skipped with the reason)");
@@ -213,6 +200,10 @@ void add_report(CLI::App& app) {
   add_backend_options(*cmd, o->backend_options);
   add_supervision_options(*cmd, o->supervision, "OUT/results.json.journal");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
+  cmd->add_option("--progress-log", o->progress_log,
+                  "Write a JSON line per finished case (its stage, seconds and the stage's "
+                  "estimate of the time left then) to this file: bench/eta_check.py judges the "
+                  "estimates by it");
   cmd->callback([o] {
     if (o->supervision.resume && !o->results.empty())
       throw UsageError("--resume finishes a measuring run: give no RESULTS with it");
@@ -310,13 +301,31 @@ void add_report(CLI::App& app) {
 
     if (!o->shard.empty()) r.shard = parse_shard_option(o->shard);
 
+    // The matrix's backends, made once: a worker runs case after case on them; the supervisor
+    // lists the cases by them and lets them go.
+    std::optional<reports::MatrixBackends> backends = reports::matrix_backends(r.matrix);
+    // A browser drawing in software (webgl on SwiftShader) takes many times the other backends'
+    // time a case (4.8 s against 0.3-0.6 s on a 2-core Zen 5, a prism's 20 s): measured on the
+    // simplest scene of each surface type unless asked for all.
+    for (const auto& b : backends->available) {
+      if (o->full || o->all_scenes || b->name() != "webgl") continue;
+      const std::optional<DeviceInfo> device = b->device();
+      if (!device || !device->software) continue;
+      r.matrix.sampled_backends.push_back(b->name());
+      r.matrix.sample_scenes = reports::simplest_of_each_surface_type(scenes);
+      r.matrix.sample_why = "its WebGL draws in software here (" + device->name +
+                            "): the simplest scene of each surface type; --all-scenes or --full "
+                            "measures every scene";
+    }
     // The run's cases (a shard's), each run in a worker (or here, --isolate none), journaled.
-    const std::vector<std::pair<std::string, double>> all = reports::report_cases(scenes, r);
+    const std::vector<std::pair<std::string, double>> all =
+        reports::report_cases(scenes, r, &*backends);
+    const json skipped = backends->skipped;
+    if (!o->supervision.worker && o->supervision.isolate != "none") backends.reset();
     std::optional<reports::ShardPlan> plan;
     if (r.shard) plan = reports::plan_shard(*r.shard, all);
     json results = reports::report_header(scenes, r);
     reports::add_to_benchmark_context(results["fingerprint"]);
-    std::optional<reports::MatrixBackends> backends;  // made once, where cases run
     conformance::Suite matrix_suite, sweep_suite;
     // One case here: the part of the results it measures.
     const auto run_case = [&](const std::string& key) -> json {
@@ -351,7 +360,8 @@ void add_report(CLI::App& app) {
                       .fingerprint = results["fingerprint"],
                       .options = results["options"],
                       .cases = {},
-                      .quiet = o->quiet};
+                      .quiet = o->quiet,
+                      .resumed = {}};
     run.options["min_time"] = r.matrix.min_time;
     run.options["images"] = !r.matrix.images.empty();
     run.options["sweep"] = {
@@ -359,48 +369,48 @@ void add_report(CLI::App& app) {
         {"size", std::to_string(r.sweep.width) + "x" + std::to_string(r.sweep.height)},
         {"repetitions", r.sweep.repetitions}};
     if (plan) run.options["shard"] = plan->record;
-    std::map<std::string, int> stage_total, stage_done;
-    for (const auto& [key, cost] : all)
-      if (!plan || plan->holds(key)) {
-        run.cases.push_back({key, cost});
-        ++stage_total[key.substr(0, key.find('/'))];
-      }
-    StageProgress progress{o->quiet, "", nullptr};
-    for (const json& skip : reports::matrix_backends(r.matrix).skipped)
+    // Run so that every backend's cases are timed early (the estimates are calibrated on them);
+    // put together in the run's order all the same.
+    std::vector<std::pair<std::string, double>> held;
+    for (const auto& c : all)
+      if (!plan || plan->holds(c.first)) held.push_back(c);
+    const std::vector<std::pair<std::string, double>> order = reports::calibrating_order(held);
+    for (const auto& [key, cost] : order) run.cases.push_back({key, cost});
+    for (const json& skip : skipped)
       if (!o->quiet)
         std::fprintf(stderr, "report: %s skipped: %s\n", skip["backend"].get<std::string>().c_str(),
                      skip["reason"].get<std::string>().c_str());
+    if (!o->quiet)
+      for (const std::string& b : r.matrix.sampled_backends)
+        std::fprintf(stderr, "report: %s on a sample: %s\n", b.c_str(),
+                     r.matrix.sample_why.c_str());
+    CaseProgress progress("report", order, o->quiet, o->progress_log);
+    run.resumed = [&](const std::string& key) { progress.resumed(key); };
     const auto show = [&](const std::string& key, const json& record) {
-      const std::string stage = key.substr(0, key.find('/'));
-      if (unfinished_record(record)) {
-        if (progress.reporter) progress.reporter->done();
-        progress.reporter.reset();
-        progress.stage.clear();
-        std::fputs(("report: " + unfinished_lines(key, record)).c_str(), stderr);
-      }
-      progress(stage, key, ++stage_done[stage], stage_total[stage]);
+      if (unfinished_record(record)) progress.say("report: " + unfinished_lines(key, record));
+      progress.finished(key);
     };
     std::optional<reports::Journal> journal;
     const std::map<std::string, json> records =
         run_supervised(run, o->supervision, run_case, show, journal);
-    if (progress.reporter) progress.reporter->done();
+    progress.close();
     // The parts put together in the run's order; a case that did not finish in its place.
     std::vector<std::string> keys;
     std::vector<json> made;  // the unfinished matrix cases' parts
     made.reserve(run.cases.size());
     std::vector<std::pair<std::string, const json*>> parts;
     results["unfinished"] = json::array();
-    for (const RunCase& c : run.cases) {
-      keys.push_back(c.key);
-      const json& record = records.at(c.key);
+    for (const auto& [key, cost] : held) {
+      keys.push_back(key);
+      const json& record = records.at(key);
       if (!unfinished_record(record)) {
-        parts.emplace_back(c.key, &record);
+        parts.emplace_back(key, &record);
         continue;
       }
-      results["unfinished"].push_back(reports::unfinished_entry(c.key, record));
-      if (json part = reports::unfinished_part(c.key, record, scenes, r); !part.is_null()) {
+      results["unfinished"].push_back(reports::unfinished_entry(key, record));
+      if (json part = reports::unfinished_part(key, record, scenes, r); !part.is_null()) {
         made.push_back(std::move(part));
-        parts.emplace_back(c.key, &made.back());
+        parts.emplace_back(key, &made.back());
       }
     }
     results.update(reports::assemble_report(results, parts, keys));

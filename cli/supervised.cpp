@@ -90,9 +90,10 @@ std::map<std::string, nlohmann::json> run_supervised(
                  journal->path().c_str(), records.size(), run.cases.size());
   std::vector<const RunCase*> to_run;
   for (const RunCase& c : run.cases) {
-    if (const auto it = records.find(c.key); it != records.end())
+    if (const auto it = records.find(c.key); it != records.end()) {
+      if (run.resumed) run.resumed(c.key);
       show(c.key, it->second);
-    else
+    } else
       to_run.push_back(&c);
   }
   // A case finished (here, by a worker, or by a supervisor that saw it fail): journaled, shown.

@@ -43,6 +43,8 @@ struct SupervisedRun {
   nlohmann::json fingerprint, options;
   std::vector<RunCase> cases;
   bool quiet = false;
+  // Called for each case a resumed journal holds, before its `show`.
+  std::function<void(const std::string& key)> resumed;
 };
 
 // Runs the run's cases, those its journal does not hold already (with --resume): each in a

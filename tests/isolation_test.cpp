@@ -256,6 +256,47 @@ TEST(ResumedReport, RunsKilledAtRandomAndResumedEqualAnUninterruptedOne) {
   EXPECT_GE(interrupted, runs / 2);
 }
 
+// The report's progress log (--progress-log): a line per case run, in stages as the cases ran,
+// each with the stage's count and its estimate of the time left, none left after its last case.
+TEST(ReportProgress, LogsEachCaseOnceWithItsStagesEstimate) {
+  const std::string dir = test::make_temp_dir();
+  std::vector<std::string> argv = small_report(dir + "/out");
+  argv.insert(argv.end(), {"--progress-log", dir + "/progress.jsonl"});
+  const test::ProcessResult r = test::run_process(argv, 300.0);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(dir + "/progress.jsonl");
+  std::vector<json> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(json::parse(line));
+  ASSERT_EQ(lines.size(), 11u);
+  std::vector<std::string> stages, keys;
+  double t = 0.0;
+  for (const json& l : lines) {
+    if (stages.empty() || stages.back() != l["stage"]) stages.push_back(l["stage"]);
+    keys.push_back(l["key"]);
+    EXPECT_EQ(l["key"].get<std::string>().rfind(l["stage"].get<std::string>() + "/", 0), 0u);
+    EXPECT_GE(l["t"].get<double>(), t);
+    t = l["t"];
+    EXPECT_GE(l["seconds"].get<double>(), 0.0);
+    EXPECT_GE(l["left"].get<double>(), 0.0);
+  }
+  EXPECT_EQ(stages, (std::vector<std::string>{"matrix", "sweep", "scaling"}));
+  // Each stage counts its own cases, one more a line, and expects nothing after its last.
+  const std::map<std::string, int> totals = {{"matrix", 2}, {"sweep", 1}, {"scaling", 8}};
+  std::map<std::string, int> done;
+  for (const json& l : lines) {
+    const std::string stage = l["stage"];
+    EXPECT_EQ(l["total"].get<int>(), totals.at(stage));
+    EXPECT_EQ(l["done"].get<int>(), ++done[stage]);
+    if (done[stage] == totals.at(stage)) {
+      EXPECT_EQ(l["left"].get<double>(), 0.0);
+    }
+  }
+  std::vector<std::string> journaled = journal_keys(dir + "/out/results.json.journal");
+  std::sort(keys.begin(), keys.end());
+  std::sort(journaled.begin(), journaled.end());
+  EXPECT_EQ(keys, journaled);
+}
+
 // A report whose faulty backend crashes on one case: the case is in the results with its
 // verdict, the others as a clean run's, and the gate calls it a regression where the baseline
 // had it pass.
