@@ -244,6 +244,11 @@ class Backend {
   // Follows one ray, recording at most `max_events` events.
   virtual Trace trace(const Scene& scene, const Ray& ray, const MarchParams& params,
                       int max_events) const = 0;
+  // A run of cases between two of them: lets go of what it keeps working for the last scene
+  // (webgl: its page, whose browser went on spending both cores of a 2-core machine on
+  // SwiftShader's threads after the case, slowing the next cases of the other backends). The
+  // next frame opens what it needs again.
+  virtual void rest() const {}
 };
 
 // ---- The registry -----------------------------------------------------------------------------

@@ -334,6 +334,7 @@ void add_report(CLI::App& app) {
         json part = reports::run_report_part(
             scenes, r, [&](const std::string& k) { return k == key; }, {matrix_suite, sweep_suite},
             nullptr, &*backends, /*every_stage=*/false);
+        for (const auto& b : backends->available) b->rest();
         // A case this process cannot run (its backend unavailable here, not where the run was
         // planned) says so, and why, rather than coming back empty.
         const std::vector<std::string> measured = reports::report_part_keys(part);

@@ -199,6 +199,14 @@ Availability WebGlBackend::availability() const {
   return {};
 }
 
+void WebGlBackend::rest() const {
+  if (!session_) return;
+  const std::lock_guard<std::mutex> lock(session_->mutex);
+  if (session_->page.empty()) return;
+  session_->browser->navigate("about:blank", kStartTimeout);
+  session_->page.clear();
+}
+
 std::optional<DeviceInfo> WebGlBackend::device() const {
   if (!session()) return std::nullopt;
   const json& info = session_->info;

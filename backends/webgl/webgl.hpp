@@ -37,6 +37,7 @@ class WebGlBackend final : public Backend {
   // The page's own time for the last frame's draw and read-back of its float targets, without
   // the transfer through the DevTools protocol.
   std::optional<double> last_frame_seconds() const override;
+  void rest() const override;
 
  private:
   struct Session;            // the browser, its page and the temporary folder
