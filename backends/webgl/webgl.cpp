@@ -145,7 +145,9 @@ WebGlBackend::~WebGlBackend() = default;
 // The browser starts on first use, not when the backend is listed: every command builds the
 // backend registry, and few draw.
 WebGlBackend::Session* WebGlBackend::session() const {
-  std::call_once(started_, [this] {
+  const std::lock_guard<std::mutex> lock(start_);
+  if (!started_) [this] {
+    started_ = true;
     try {
       const std::vector<std::string> flags = webgl::device_flags(options_.device);
       const std::optional<std::string> chromium = webgl::find_chromium();
@@ -182,7 +184,7 @@ WebGlBackend::Session* WebGlBackend::session() const {
     } catch (const std::exception& e) {
       unavailable_ = e.what();
     }
-  });
+  }();
   return session_.get();
 }
 
@@ -200,11 +202,12 @@ Availability WebGlBackend::availability() const {
 }
 
 void WebGlBackend::rest() const {
+  // The browser itself goes: a page left for about:blank was not enough, SwiftShader's threads
+  // in its GPU process went on spinning. The next frame starts it again (about a second).
+  const std::lock_guard<std::mutex> lock(start_);
   if (!session_) return;
-  const std::lock_guard<std::mutex> lock(session_->mutex);
-  if (session_->page.empty()) return;
-  session_->browser->navigate("about:blank", kStartTimeout);
-  session_->page.clear();
+  session_.reset();
+  started_ = false;
 }
 
 std::optional<DeviceInfo> WebGlBackend::device() const {

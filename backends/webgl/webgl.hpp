@@ -44,7 +44,8 @@ class WebGlBackend final : public Backend {
   Session* session() const;  // null when unavailable (unavailable_ says why)
 
   BackendOptions options_;
-  mutable std::once_flag started_;
+  mutable std::mutex start_;  // guards started_ and session_'s making and letting go
+  mutable bool started_ = false;
   mutable std::unique_ptr<Session> session_;
   mutable std::string unavailable_;
 };
