@@ -150,7 +150,8 @@ void add_report(CLI::App& app) {
                 "scaling series on every backend");
   cmd->add_flag("--all-scenes", o->all_scenes,
                 "Measure a browser that draws in software (the webgl backend on SwiftShader) on "
-                "every scene too (default: one scene of each surface type; --full implies it)");
+                "every scene and method too (default: the simplest scene of each surface type, "
+                "one method each; --full implies it)");
   cmd->add_option("--backend", o->backends,
                   "Backend to measure (repeat; default: " + joined(kernel_backend_names()) +
                       " — those unavailable here skipped with the reason)");
@@ -305,17 +306,21 @@ void add_report(CLI::App& app) {
     // lists the cases by them and lets them go.
     std::optional<reports::MatrixBackends> backends = reports::matrix_backends(r.matrix);
     // A browser drawing in software (webgl on SwiftShader) takes many times the other backends'
-    // time a case (4.8 s against 0.3-0.6 s on a 2-core Zen 5, a prism's 20 s): measured on the
-    // simplest scene of each surface type unless asked for all.
+    // time a case (4.8 s against 0.3-0.6 s on a 2-core Zen 5, a prism's 20 s): measured on a
+    // sample unless asked for all.
     for (const auto& b : backends->available) {
       if (o->full || o->all_scenes || b->name() != "webgl") continue;
       const std::optional<DeviceInfo> device = b->device();
       if (!device || !device->software) continue;
       r.matrix.sampled_backends.push_back(b->name());
-      r.matrix.sample_scenes = reports::simplest_of_each_surface_type(scenes);
+      // The simplest scene of each surface type, each with one method, the methods in turn.
+      const std::vector<std::string> chosen = reports::simplest_of_each_surface_type(scenes);
+      for (size_t k = 0; k < chosen.size(); ++k)
+        r.matrix.sample_cases.push_back(
+            chosen[k] + "/" + to_string(r.matrix.methods[k % r.matrix.methods.size()]));
       r.matrix.sample_why = "its WebGL draws in software here (" + device->name +
-                            "): the simplest scene of each surface type; --all-scenes or --full "
-                            "measures every scene";
+                            "): the simplest scene of each surface type, with one method each, "
+                            "the methods in turn; --all-scenes or --full measures every case";
     }
     // The run's cases (a shard's), each run in a worker (or here, --isolate none), journaled.
     const std::vector<std::pair<std::string, double>> all =

@@ -392,7 +392,7 @@ def ranking_section(results):
         row = [b["rank"], b["backend"], device_text(b), mrays(b["rays_per_s"]),
                f'{b["passed"]}/{b["cases"]} pass' + (f', {b["limits"]} limit' if b.get("limits") else "")
                + (f', {b["errors"]} errors' if b["errors"] else "")
-               + (f'; a sample: {b["sampled"]["scenes"]} of {b["sampled"]["of_scenes"]} scenes'
+               + (f'; a sample: {b["sampled"]["cases"]} of {b["sampled"]["of_cases"]} cases'
                   if b.get("sampled") else "")]
         for m in methods:
             mm = b["methods"].get(m)
@@ -418,7 +418,7 @@ def ranking_section(results):
         parts.append("<p>Skipped: " + "; ".join(f'{esc(s["backend"])} ({esc(s["reason"])})' for s in skipped) + "</p>")
     for s in results.get("matrix", {}).get("sampled", []):
         parts.append(f'<p class="sampled">Measured on a sample: {esc(s["backend"])}, on '
-                     f'{len(s["scenes"])} of {s["of_scenes"]} scenes ({esc(", ".join(s["scenes"]))}), '
+                     f'{len(s["cases"])} of {s["of_cases"]} cases ({esc(", ".join(s["cases"]))}), '
                      f'because {esc(s["why"])}. Its figures are of those scenes alone.</p>')
     return "\n".join(parts)
 

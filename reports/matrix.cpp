@@ -332,11 +332,12 @@ MatrixBackends matrix_backends(const MatrixOptions& o) {
   return out;
 }
 
-bool matrix_measures(const MatrixOptions& o, const std::string& backend, const std::string& scene) {
+bool matrix_measures(const MatrixOptions& o, const std::string& backend, const std::string& scene,
+                     const std::string& method) {
   const auto has = [](const std::vector<std::string>& v, const std::string& x) {
     return std::find(v.begin(), v.end(), x) != v.end();
   };
-  return !has(o.sampled_backends, backend) || has(o.sample_scenes, scene);
+  return !has(o.sampled_backends, backend) || has(o.sample_cases, scene + "/" + method);
 }
 
 std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
@@ -348,7 +349,7 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
   for (const auto& backend : (built ? *built : *own).available)
     for (const Scene& scene : scenes)
       for (const Method m : o.methods) {
-        if (!matrix_measures(o, backend->name(), scene.name)) continue;
+        if (!matrix_measures(o, backend->name(), scene.name, to_string(m))) continue;
         const std::string method = to_string(m);
         double cost = 0.0;
         if (o.conformance)
@@ -376,14 +377,14 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
           skip["backend"].get<std::string>() + " skipped: " + skip["reason"].get<std::string>(), 0,
           0);
   const auto held = [&](const Backend& backend, Method m, const Scene& scene) {
-    return matrix_measures(o, backend.name(), scene.name) &&
+    return matrix_measures(o, backend.name(), scene.name, to_string(m)) &&
            (!o.holds || o.holds(matrix_case_key(backend.name(), to_string(m), scene.name)));
   };
   for (const std::string& b : o.sampled_backends) {
     if (!out.contains("sampled")) out["sampled"] = json::array();
     out["sampled"].push_back({{"backend", b},
-                              {"scenes", o.sample_scenes},
-                              {"of_scenes", scenes.size()},
+                              {"cases", o.sample_cases},
+                              {"of_cases", scenes.size() * o.methods.size()},
                               {"why", o.sample_why}});
   }
   int total = 0;

@@ -35,15 +35,17 @@ struct MatrixOptions {
   std::filesystem::path images;
   // The cases to run, by matrix_case_key (a shard's, issue 24); empty: every case.
   std::function<bool(const std::string& key)> holds;
-  // Backends measured on a sample of the scenes, not all: one whose cases take many times the
-  // others' (a browser drawing in software). `sample_scenes` names the scenes, `sample_why` says
-  // why, as the results, the ranking and the page repeat it.
-  std::vector<std::string> sampled_backends, sample_scenes;
+  // Backends measured on a sample of the matrix, not all of it: one whose cases take many times
+  // the others' (a browser drawing in software). `sample_cases` names the cases as
+  // "SCENE/METHOD", `sample_why` says why, as the results, the ranking and the page repeat it.
+  std::vector<std::string> sampled_backends, sample_cases;
   std::string sample_why;
 };
 
-// Whether the matrix measures `backend` on `scene` (every scene but for a sampled backend).
-bool matrix_measures(const MatrixOptions& o, const std::string& backend, const std::string& scene);
+// Whether the matrix measures `backend` on `scene` with `method` (every case but for a sampled
+// backend).
+bool matrix_measures(const MatrixOptions& o, const std::string& backend, const std::string& scene,
+                     const std::string& method);
 
 // A matrix case's key in a sharded run's case list: "matrix/BACKEND/METHOD/SCENE".
 std::string matrix_case_key(const std::string& backend, const std::string& method,

@@ -377,8 +377,8 @@ json rank_backends(const json& matrix) {
   for (const json& sample : matrix.value("sampled", json::array()))
     for (json& b : ranking)
       if (b["backend"] == sample["backend"])
-        b["sampled"] = {{"scenes", sample["scenes"].size()},
-                        {"of_scenes", sample["of_scenes"]},
+        b["sampled"] = {{"cases", sample["cases"].size()},
+                        {"of_cases", sample["of_cases"]},
                         {"why", sample["why"]}};
   std::stable_sort(ranking.begin(), ranking.end(), [](const json& a, const json& b) {
     const bool ca = a["passed"] == a["cases"], cb = b["passed"] == b["cases"];
@@ -509,8 +509,8 @@ std::string describe_selection(const json& results, const std::string& type) {
       ended += (ended.empty() ? "" : ", ") + std::to_string(n.get<int>()) + " " + verdict;
     if (!ended.empty()) s += " (" + ended + ")";
     if (b.contains("sampled"))
-      s += " on a sample of " + std::to_string(b["sampled"]["scenes"].get<int>()) + " of " +
-           std::to_string(b["sampled"]["of_scenes"].get<int>()) + " scenes";
+      s += " on a sample of " + std::to_string(b["sampled"]["cases"].get<int>()) + " of " +
+           std::to_string(b["sampled"]["of_cases"].get<int>()) + " cases";
     if (b.contains("device"))
       s += "  on " + b["device"]["name"].get<std::string>() +
            (b["device"]["software"].get<bool>() ? " (software: a rasteriser on the CPU)" : "") +

@@ -281,12 +281,12 @@ TEST(Ranking, ASampledBackendSaysOnHowManyScenes) {
   const json matrix = {
       {"cases", cases},
       {"sampled",
-       {{{"backend", "browser"}, {"scenes", {"x"}}, {"of_scenes", 3}, {"why", "slow"}}}}};
+       {{{"backend", "browser"}, {"cases", {"x/analytic"}}, {"of_cases", 3}, {"why", "slow"}}}}};
   const json ranking = rank_backends(matrix);
   ASSERT_EQ(ranking.size(), 2u);
   EXPECT_EQ(ranking[1]["backend"], "browser");
-  EXPECT_EQ(ranking[1]["sampled"]["scenes"], 1);
-  EXPECT_EQ(ranking[1]["sampled"]["of_scenes"], 3);
+  EXPECT_EQ(ranking[1]["sampled"]["cases"], 1);
+  EXPECT_EQ(ranking[1]["sampled"]["of_cases"], 3);
   EXPECT_FALSE(ranking[0].contains("sampled"));
   const json results = {{"recommendation", recommend(ranking, json::object())},
                         {"ranking", ranking},
@@ -295,7 +295,7 @@ TEST(Ranking, ASampledBackendSaysOnHowManyScenes) {
                           {"vulkan", json::object()},
                           {"opengl", json::object()}}}};
   const std::string text = describe_selection(results, "");
-  EXPECT_NE(text.find("1/1 cases pass, 0 at their method's limit on a sample of 1 of 3 scenes"),
+  EXPECT_NE(text.find("1/1 cases pass, 0 at their method's limit on a sample of 1 of 3 cases"),
             std::string::npos)
       << text;
 }
