@@ -316,8 +316,8 @@ void add_report(CLI::App& app) {
       // The simplest scene of each surface type, each with one method, the methods in turn.
       const std::vector<std::string> chosen = reports::simplest_of_each_surface_type(scenes);
       for (size_t k = 0; k < chosen.size(); ++k)
-        r.matrix.sample_cases.push_back(
-            chosen[k] + "/" + to_string(r.matrix.methods[k % r.matrix.methods.size()]));
+        r.matrix.sample_cases.push_back(chosen[k] + "/" +
+                                        to_string(r.matrix.methods[k % r.matrix.methods.size()]));
       r.matrix.sample_why = "its WebGL draws in software here (" + device->name +
                             "): the simplest scene of each surface type, with one method each, "
                             "the methods in turn; --all-scenes or --full measures every case";

@@ -146,45 +146,46 @@ WebGlBackend::~WebGlBackend() = default;
 // backend registry, and few draw.
 WebGlBackend::Session* WebGlBackend::session() const {
   const std::lock_guard<std::mutex> lock(start_);
-  if (!started_) [this] {
-    started_ = true;
-    try {
-      const std::vector<std::string> flags = webgl::device_flags(options_.device);
-      const std::optional<std::string> chromium = webgl::find_chromium();
-      if (!chromium) {
-        unavailable_ =
-            "no Chromium found (Debian's chromium package, which ci/packages.txt installs; or "
-            "set FLATMARCH_CHROMIUM to a Chromium)";
-        return;
+  if (!started_)
+    [this] {
+      started_ = true;
+      try {
+        const std::vector<std::string> flags = webgl::device_flags(options_.device);
+        const std::optional<std::string> chromium = webgl::find_chromium();
+        if (!chromium) {
+          unavailable_ =
+              "no Chromium found (Debian's chromium package, which ci/packages.txt installs; or "
+              "set FLATMARCH_CHROMIUM to a Chromium)";
+          return;
+        }
+        auto s = std::make_unique<Session>();
+        char folder[] = "/tmp/flatmarch-webgl-XXXXXX";
+        if (!mkdtemp(folder)) throw std::runtime_error("cannot make a temporary folder");
+        s->folder = folder;
+        s->browser = std::make_unique<webgl::Chromium>(*chromium, flags, kStartTimeout);
+        s->info = s->browser->evaluate(kProbe, kStartTimeout);
+        if (s->info.is_null()) {
+          unavailable_ = s->browser->product() + " has no WebGL2 here";
+          return;
+        }
+        if (!s->info.value("float_targets", false)) {
+          unavailable_ = s->browser->product() + "'s WebGL2 (" +
+                         s->info.value("renderer", std::string()) +
+                         ") cannot draw to float targets (EXT_color_buffer_float)";
+          return;
+        }
+        if (const std::string e = kernel_shape_error(options_.kernel_shape); !e.empty()) {
+          unavailable_ = e;
+          return;
+        }
+        // Forced, the pages take the shape; else each picks it by its renderer, as on the web.
+        if (options_.kernel_shape == "software" || options_.kernel_shape == "gpu")
+          s->shape = options_.kernel_shape;
+        session_ = std::move(s);
+      } catch (const std::exception& e) {
+        unavailable_ = e.what();
       }
-      auto s = std::make_unique<Session>();
-      char folder[] = "/tmp/flatmarch-webgl-XXXXXX";
-      if (!mkdtemp(folder)) throw std::runtime_error("cannot make a temporary folder");
-      s->folder = folder;
-      s->browser = std::make_unique<webgl::Chromium>(*chromium, flags, kStartTimeout);
-      s->info = s->browser->evaluate(kProbe, kStartTimeout);
-      if (s->info.is_null()) {
-        unavailable_ = s->browser->product() + " has no WebGL2 here";
-        return;
-      }
-      if (!s->info.value("float_targets", false)) {
-        unavailable_ = s->browser->product() + "'s WebGL2 (" +
-                       s->info.value("renderer", std::string()) +
-                       ") cannot draw to float targets (EXT_color_buffer_float)";
-        return;
-      }
-      if (const std::string e = kernel_shape_error(options_.kernel_shape); !e.empty()) {
-        unavailable_ = e;
-        return;
-      }
-      // Forced, the pages take the shape; else each picks it by its renderer, as on the web.
-      if (options_.kernel_shape == "software" || options_.kernel_shape == "gpu")
-        s->shape = options_.kernel_shape;
-      session_ = std::move(s);
-    } catch (const std::exception& e) {
-      unavailable_ = e.what();
-    }
-  }();
+    }();
   return session_.get();
 }
 
