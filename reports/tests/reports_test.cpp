@@ -230,6 +230,13 @@ TEST(SweepAnalysis, NothingStableRecommendsNothing) {
   EXPECT_TRUE(analysis[0]["stable"].empty());
 }
 
+// A machine's fingerprint as describe_selection reads it.
+json test_fingerprint() {
+  return {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
+          {"vulkan", json::object()},
+          {"opengl", json::object()}};
+}
+
 json matrix_case(const std::string& backend, const std::string& method, const std::string& scene,
                  double rays, bool passed, double steps) {
   return {{"name", backend + "/" + method + "/" + scene + "/32x18"},
@@ -290,10 +297,7 @@ TEST(Ranking, ASampledBackendSaysOnHowManyScenes) {
   EXPECT_FALSE(ranking[0].contains("sampled"));
   const json results = {{"recommendation", recommend(ranking, json::object())},
                         {"ranking", ranking},
-                        {"fingerprint",
-                         {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
-                          {"vulkan", json::object()},
-                          {"opengl", json::object()}}}};
+                        {"fingerprint", test_fingerprint()}};
   const std::string text = describe_selection(results, "");
   EXPECT_NE(text.find("1/1 cases pass, 0 at their method's limit on a sample of 1 of 3 cases"),
             std::string::npos)
@@ -351,12 +355,8 @@ TEST(Ranking, AFallbackIsMarkedAndNamesTheStableMethod) {
   const json& translation = rec["parameters"]["translation"];
   EXPECT_EQ(translation["source"], "sweep");
   EXPECT_TRUE(translation["fallback"].get<bool>());
-  const json results = {{"recommendation", rec},
-                        {"ranking", ranking},
-                        {"fingerprint",
-                         {{"cpu", {{"model", "test"}, {"logical_cores", 2}, {"isa", "avx2"}}},
-                          {"vulkan", json::object()},
-                          {"opengl", json::object()}}}};
+  const json results = {
+      {"recommendation", rec}, {"ranking", ranking}, {"fingerprint", test_fingerprint()}};
   const std::string text = describe_selection(results, "");
   EXPECT_NE(text.find("prism       --backend scalar --method sphere --eps 0.0001 --offset 0.0002"
                       "   (a fallback, the defaults: no point of the sweep passes on every prism "
