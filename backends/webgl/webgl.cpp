@@ -204,7 +204,8 @@ Availability WebGlBackend::availability() const {
 
 void WebGlBackend::rest() const {
   // The browser itself goes: a page left for about:blank was not enough, SwiftShader's threads
-  // in its GPU process went on spinning. The next frame starts it again (half a second a case on a 2-core Zen 5).
+  // in its GPU process went on spinning. The next frame starts it again (half a second a case on a
+  // 2-core Zen 5).
   const std::lock_guard<std::mutex> lock(start_);
   if (!session_) return;
   session_.reset();
