@@ -99,6 +99,7 @@ void CaseProgress::finished(const std::string& key) {
                                  {"key", key},
                                  {"t", now - start_},
                                  {"seconds", seconds},
+                                 {"cost", s.estimate.cost_of(key)},
                                  {"left", s.estimate.seconds_left()},
                                  {"done", s.estimate.done()},
                                  {"total", s.estimate.total()}};

@@ -21,8 +21,9 @@ namespace flatmarch::cli {
 class CaseProgress {
  public:
   // `cases` in the order they run, (key, expected seconds). `log_file`, when given, gets a JSON
-  // line per finished case: {"stage", "key", "t" (seconds since the start), "seconds", "left"
-  // (the stage's estimate then), "done", "total"}: what bench/eta_check.py judges the estimates by.
+  // line per finished case: {"stage", "key", "t" (seconds since the start), "seconds", "cost"
+  // (the model's seconds), "left" (the stage's estimate then), "done", "total"}: what
+  // bench/eta_check.py judges the estimates by.
   CaseProgress(std::string command, const std::vector<std::pair<std::string, double>>& cases,
                bool quiet, const std::string& log_file = "");
   ~CaseProgress();

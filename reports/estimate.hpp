@@ -1,9 +1,14 @@
 // How long the rest of a stage of cases will take, from the cost model (shard.hpp: each case's
-// expected seconds, set on one machine) calibrated on this run: the seconds each finished case
-// took against its expected cost give a rate per group of cases (a backend, and a backend's
-// method), which scales the expected cost of the cases still to run. A group no case of which
-// has finished takes the stage's rate so far; before any case has finished, the model's own
-// seconds stand.
+// expected seconds, set on one machine) calibrated on this run. The model's seconds are off in
+// two ways that matter: by backend and method (a backend twice as fast here as where the model
+// was set), and by item (a scene, a surface type, a family of a scaling series that costs more
+// or less than the model says, and differently for each method and on each backend: a prism
+// costs the scalar backend's sphere tracing ten times a torus, its analytic method twice). So a
+// case's seconds are taken as its cost x a rate of its backend and method x a factor of its item
+// with its method x a factor of its item on its backend, fitted to the cases that have finished.
+// A rate not yet seen falls back to the backend's, then to the stage's; a factor not yet seen is
+// 1, and each is drawn toward 1 by a pseudo-case (of the stage's mean seconds so far) until
+// cases of its own outweigh it. Before any case has finished, the model's own seconds stand.
 #pragma once
 
 #include <cstddef>
@@ -15,18 +20,20 @@
 namespace flatmarch::reports {
 
 // A case's place in the calibration: its stage ("matrix", "sweep", "scaling"), its group (the
-// backend of a matrix case, the method of a sweep group, the family of a scaling series) and its
-// subgroup (the backend's method; a scaling series' family and backend). From the case keys of
-// matrix.hpp, sweep.hpp and scaling.hpp.
+// backend; "" for a sweep, which has one), its method, its subgroup (backend/method) and its item
+// (the scene of a matrix case, the surface type of a sweep group, the family of a scaling
+// series). From the case keys of matrix.hpp, sweep.hpp and scaling.hpp.
 struct CaseGroups {
-  std::string stage, group, subgroup;
+  std::string stage, group, method, subgroup, item;
 };
 CaseGroups case_groups(const std::string& key);
 
-// The order to run cases in so that every group is measured early and evenly: the stages in
-// their order, and within a stage each group's cases (in the order given) spread evenly over the
-// stage, so that its first tenth holds a tenth of every group's cases. `cases` are (key, cost); so
-// are the result's.
+// The order to run cases in so that every part of a stage is measured early and evenly, and
+// the cases left at any time are like those done: the stages in their order; within a stage the
+// groups' cases spread evenly over it, within a group its subgroups' spread evenly over the
+// group's, and within a subgroup its items in a bit-reversed order (any first part of it spans
+// the items' whole list), turned by a different amount for each subgroup so that subgroups run
+// different items at the same time. `cases` are (key, cost); so are the result's.
 std::vector<std::pair<std::string, double>> calibrating_order(
     const std::vector<std::pair<std::string, double>>& cases);
 
@@ -42,25 +49,20 @@ class StageEstimate {
 
   int total() const { return static_cast<int>(cost_.size()); }
   int done() const { return static_cast<int>(done_.size()); }
+  // The model's expected seconds of a case of the stage (0 for one not in it).
+  double cost_of(const std::string& key) const;
   // Seconds the cases not yet finished are expected to take.
-  double seconds_left() const;
+  double seconds_left() const { return left_; }
   // The share of the stage's expected time done: spent / (spent + left).
   double fraction_done() const;
   double seconds_spent() const { return spent_; }
 
  private:
-  struct Rate {
-    double seconds = 0.0, cost = 0.0;
-    bool known() const { return cost > 0.0; }
-    double value() const { return seconds / cost; }
-  };
-  double rate_of(const std::string& key) const;
+  void refit();  // left_ from the cases done
 
   std::map<std::string, double> cost_;
   std::map<std::string, double> done_;
-  std::map<std::string, Rate> groups_, subgroups_;
-  Rate stage_;
-  double spent_ = 0.0;
+  double spent_ = 0.0, left_ = 0.0;
 };
 
 }  // namespace flatmarch::reports

@@ -356,7 +356,8 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
           cost += conformance_case_cost(backend->name(), method, edge_count(scene), o.conform_width,
                                         o.conform_height);
         if (o.timing)
-          cost += timed_case_cost(frame_cost(backend->name(), method, o.width, o.height),
+          cost += timed_case_cost(backend->name(),
+                                  frame_cost(backend->name(), method, o.width, o.height),
                                   o.repetitions, o.min_time);
         cases.emplace_back(matrix_case_key(backend->name(), to_string(m), scene.name),
                            cost * scene_cost_factor(scene));

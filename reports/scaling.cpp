@@ -120,7 +120,7 @@ std::vector<std::pair<std::string, double>> scaling_cases(const ScalingOptions& 
           // Rays run to their path length: about max_distance / 20 of a gallery frame's cost.
           const double frame = frame_cost(b->name(), to_string(m), p.width, p.height) *
                                std::max(1.0, p.max_distance / 20.0);
-          cost += timed_case_cost(frame, o.repetitions, o.min_time);
+          cost += timed_case_cost(b->name(), frame, o.repetitions, o.min_time);
         }
         cases.emplace_back(scaling_case_key(s.family, b->name(), to_string(m)), cost);
       }

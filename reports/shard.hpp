@@ -39,9 +39,14 @@ double conformance_case_cost(const std::string& backend, const std::string& meth
 // relaxed march about ten times the analytic method's steps).
 double frame_cost(const std::string& backend, const std::string& method, int width, int height);
 
-// The expected seconds of a case timed by Google Benchmark: an untimed frame, then `repetitions`
-// of at least `min_time` seconds and one frame each.
-double timed_case_cost(double frame_seconds, int repetitions, double min_time);
+// The expected seconds of a case of `backend` timed by Google Benchmark (register_frame_benchmark
+// in matrix.hpp): two untimed frames (the whole frame, then its colour alone: what compiles a GPU
+// backend's programs); then each of `repetitions` is one frame when a frame takes longer than
+// `min_time`, else the runs Google Benchmark makes on its way up to min_time, about 1.6 x
+// min_time in all. The SIMD backend adds its counted frame, its lane peak (5 x min_time, within
+// 0.01 to 0.1 s) and four frames on one thread.
+double timed_case_cost(const std::string& backend, double frame_seconds, int repetitions,
+                       double min_time);
 
 // The number of edges of a scene's polygons: the oracle's cost grows with it.
 int edge_count(const Scene& scene);
