@@ -50,10 +50,9 @@ TEST(CalibratingOrder, SpreadsEachBackendsCasesEvenlyOverItsStage) {
   // The matrix first (its first case came first). Three subgroups: a/x turned by 0 of its two
   // scenes, a/y by 2/3 (0), b/x by 4/3 (1). a's four, its subgroups taken in turn, at 1/8, 3/8,
   // 5/8, 7/8 of the stage; b's two at 1/4 and 3/4; then the sweep.
-  EXPECT_EQ(keys_of(order), (std::vector<std::string>{"matrix/a/x/1", "matrix/b/x/2",
-                                                      "matrix/a/y/1", "matrix/a/x/2",
-                                                      "matrix/b/x/1", "matrix/a/y/2",
-                                                      "sweep/t/sphere"}));
+  EXPECT_EQ(keys_of(order), (std::vector<std::string>{
+                                "matrix/a/x/1", "matrix/b/x/2", "matrix/a/y/1", "matrix/a/x/2",
+                                "matrix/b/x/1", "matrix/a/y/2", "sweep/t/sphere"}));
   EXPECT_EQ(order[1].second, 7);  // costs go with their keys
 }
 
@@ -64,11 +63,11 @@ TEST(CalibratingOrder, RunsASubgroupsScenesBitReversedEachSubgroupTurnedItsShare
       cases.emplace_back(std::string("matrix/a/") + method + "/s" + std::to_string(scene), 1.0);
   // 0..7 bit-reversed is 0 4 2 6 1 5 3 7; less those over 4, 0 4 2 1 3. x is turned by 0, y by
   // 5/2 (2) of its five; the two taken in turn.
-  EXPECT_EQ(keys_of(calibrating_order(cases)),
-            (std::vector<std::string>{"matrix/a/x/s0", "matrix/a/y/s2", "matrix/a/x/s4",
-                                      "matrix/a/y/s1", "matrix/a/x/s2", "matrix/a/y/s4",
-                                      "matrix/a/x/s1", "matrix/a/y/s3", "matrix/a/x/s3",
-                                      "matrix/a/y/s0"}));
+  EXPECT_EQ(
+      keys_of(calibrating_order(cases)),
+      (std::vector<std::string>{"matrix/a/x/s0", "matrix/a/y/s2", "matrix/a/x/s4", "matrix/a/y/s1",
+                                "matrix/a/x/s2", "matrix/a/y/s4", "matrix/a/x/s1", "matrix/a/y/s3",
+                                "matrix/a/x/s3", "matrix/a/y/s0"}));
 }
 
 TEST(StageEstimate, BeforeAnyCaseTheModelsSecondsStand) {
