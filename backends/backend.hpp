@@ -224,6 +224,11 @@ class Backend {
   virtual std::vector<Precision> precisions() const { return {Precision::f32, Precision::f64}; }
   // The device it runs on (GPU backends, when available); CPU backends: none.
   virtual std::optional<DeviceInfo> device() const { return std::nullopt; }
+  // Whether its first frame of a scene compiles a program of its own (the kernel specialised on
+  // the scene and the parameters) that the driver's disk cache keeps for the next process: a
+  // report compiles them ahead, several at once (opengl, vulkan; webgl's browser keeps its cache
+  // in a profile that lives as long as its page).
+  virtual bool compiles_per_scene() const { return false; }
 
   virtual Frame render(const Scene& scene, const Camera& camera, int width, int height,
                        const MarchParams& params, const Progress& progress) const = 0;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <thread>
 
 #include "backends/dynamic_library.hpp"
 #include "cli/case_progress.hpp"
@@ -132,7 +133,7 @@ void add_report(CLI::App& app) {
     std::string out = "reports/out", progress_log, size, conform_size = "160x90", sweep_size,
                 sweep_backend;
     std::string baseline, write_baseline, previous, shard, python = default_python();
-    int repetitions = 0;
+    int repetitions = 0, compile_jobs = -1;
     double min_time = 0.02;
     bool full = false, all_scenes = false, no_sweep = false, no_scaling = false, no_html = false,
          quiet = false;
@@ -146,8 +147,10 @@ void add_report(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--out", o->out, "Output folder")->capture_default_str();
   cmd->add_flag("--full", o->full,
-                "The full matrix: frames 640x360, 5 repetitions, the sweep on every scene, longer "
-                "scaling series on every backend");
+                "The full matrix: frames 640x360, 5 repetitions, the sweep on every scene in f32 "
+                "and f64 (the quick one: f32), longer "
+                "scaling series on every backend (the quick ones: simd where it is measured, else "
+                "scalar)");
   cmd->add_flag("--all-scenes", o->all_scenes,
                 "Measure a browser that draws in software (the webgl backend on SwiftShader) on "
                 "every scene and method too (default: the simplest scene of each surface type, "
@@ -171,7 +174,8 @@ void add_report(CLI::App& app) {
                   "at least one frame")
       ->capture_default_str();
   cmd->add_option("--sweep-backend", o->sweep_backend,
-                  "Backend of the sweep (default scalar: the only one with f64)");
+                  "Backend of the sweep (default: simd where it is measured, else scalar, in f32; "
+                  "--full: scalar, the backend with f64 too, in both)");
   cmd->add_option("--sweep-size", o->sweep_size, "Sweep frames WxH (default 64x36; --full 96x54)");
   cmd->add_flag("--no-sweep", o->no_sweep, "Skip the eps x offset sweep");
   cmd->add_flag("--no-scaling", o->no_scaling, "Skip the scaling series");
@@ -201,6 +205,11 @@ void add_report(CLI::App& app) {
   add_backend_options(*cmd, o->backend_options);
   add_supervision_options(*cmd, o->supervision, "OUT/results.json.journal");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
+  cmd->add_option("--compile-jobs", o->compile_jobs,
+                  "Compile the GPU backends' kernels (opengl, vulkan: a program per scene and "
+                  "method) before the matrix, this many at once, into the driver's disk cache "
+                  "(default: one per core, at most 8; 0: none, each case compiles its own)")
+      ->check(CLI::Range(0, 64));
   cmd->add_option("--progress-log", o->progress_log,
                   "Write a JSON line per finished case (its stage, seconds and the stage's "
                   "estimate of the time left then) to this file: bench/eta_check.py judges the "
@@ -261,12 +270,32 @@ void add_report(CLI::App& app) {
     r.matrix.images = o->no_html || !no_images.empty() ? fs::path() : fs::path(o->out) / "images";
     const std::vector<Scene> scenes = load_scenes(o->scenes, o->galleries);
 
+    // The CPU backend of the quick sweep and scaling series: the SIMD backend where the report
+    // measures it and it runs, else the scalar one.
+    const std::string cpu_backend = [&] {
+      const auto measured = [&](const char* name) {
+        return std::find(r.matrix.backends.begin(), r.matrix.backends.end(), name) !=
+               r.matrix.backends.end();
+      };
+      const std::unique_ptr<Backend> simd = make_backend("simd", o->backend_options);
+      return measured("simd") && simd && simd->availability().available ? "simd" : "scalar";
+    }();
     r.sweep_enabled = !o->no_sweep;
     r.sweep_all_scenes = o->full;
     r.sweep.methods = r.matrix.methods;
     r.sweep.params.max_steps = o->params.max_steps;
     r.sweep.backend_options = o->backend_options;
-    if (!o->sweep_backend.empty()) r.sweep.backend = o->sweep_backend;
+    // The quick sweep in f32, the precision every backend marches in, on the SIMD backend
+    // (cpu_backend: 2.2x the scalar backend's speed over a sweep's small frames, and the backend
+    // a CPU's ranking puts first; the two agree on every point's verdict on the l-shape and the
+    // cube); --full: the scalar backend in f32 and f64, the precision the CPU backends have
+    // beside it. The quick sweep was 72 s of a 2-core machine's report, and is 20 s.
+    if (!o->sweep_backend.empty()) {
+      r.sweep.backend = o->sweep_backend;
+    } else if (!o->full) {
+      r.sweep.backend = cpu_backend;
+    }
+    if (!o->full) r.sweep.precisions = {Precision::f32};
     if (r.sweep_enabled) {
       const std::unique_ptr<Backend> b = make_backend(r.sweep.backend, o->backend_options);
       const std::vector<std::string> kernel = kernel_backend_names();
@@ -297,7 +326,9 @@ void add_report(CLI::App& app) {
       r.scaling.resolutions = {{80, 45}, {160, 90}, {320, 180}, {640, 360}, {1280, 720}};
       r.scaling.max_distances = {10, 20, 40, 80, 160, 320};
     } else {
-      r.scaling.backends = {"scalar", "simd"};
+      // The quick series on one CPU backend (cpu_backend; the scalar backend's beside the SIMD
+      // backend's took 18 s of a 2-core machine's report); every backend with --full.
+      r.scaling.backends = {cpu_backend};
     }
 
     if (!o->shard.empty()) r.shard = parse_shard_option(o->shard);
@@ -326,6 +357,9 @@ void add_report(CLI::App& app) {
     const std::vector<std::pair<std::string, double>> all =
         reports::report_cases(scenes, r, &*backends);
     const json skipped = backends->skipped;
+    std::vector<std::string> compiling;  // the backends whose kernels a case compiles
+    for (const auto& b : backends->available)
+      if (b->compiles_per_scene()) compiling.push_back(b->name());
     if (!o->supervision.worker && o->supervision.isolate != "none") backends.reset();
     std::optional<reports::ShardPlan> plan;
     if (r.shard) plan = reports::plan_shard(*r.shard, all);
@@ -335,6 +369,9 @@ void add_report(CLI::App& app) {
     // One case here: the part of the results it measures.
     const auto run_case = [&](const std::string& key) -> json {
       if (!backends) backends = reports::matrix_backends(r.matrix);
+      if (key.rfind("compile/", 0) == 0)
+        return record_or_error(
+            [&] { return reports::run_compile_case(key, scenes, r.matrix, backends->available); });
       return record_or_error([&]() -> json {
         json part = reports::run_report_part(
             scenes, r, [&](const std::string& k) { return k == key; }, {matrix_suite, sweep_suite},
@@ -390,12 +427,36 @@ void add_report(CLI::App& app) {
       for (const std::string& b : r.matrix.sampled_backends)
         std::fprintf(stderr, "report: %s on a sample: %s\n", b.c_str(),
                      r.matrix.sample_why.c_str());
-    CaseProgress progress("report", order, o->quiet, o->progress_log);
+    // The GPU kernels of the matrix compiled first, a case a core (reports::compile_cases): not
+    // where the cases run here, nor for a run resumed (its kernels are warm from the run it
+    // finishes), nor where the driver's cache is off.
+    const int jobs =
+        o->compile_jobs >= 0
+            ? o->compile_jobs
+            : static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+    std::vector<std::pair<std::string, double>> compiled, shown;
+    const char* no_cache = std::getenv("MESA_SHADER_CACHE_DISABLE");
+    if (jobs > 0 && o->supervision.isolate == "worker" && !o->supervision.resume &&
+        !(no_cache && (std::string(no_cache) == "true" || std::string(no_cache) == "1")))
+      compiled = reports::compile_cases(order, scenes, compiling);
+    // The dearest first: the last to finish are the cheap ones, and the cores finish together.
+    std::stable_sort(compiled.begin(), compiled.end(),
+                     [](const auto& a, const auto& b) { return a.second > b.second; });
+    for (const auto& [key, cost] : compiled) shown.emplace_back(key, cost / jobs);
+    shown.insert(shown.end(), order.begin(), order.end());
+    CaseProgress progress("report", shown, o->quiet, o->progress_log);
     run.resumed = [&](const std::string& key) { progress.resumed(key); };
     const auto show = [&](const std::string& key, const json& record) {
       if (unfinished_record(record)) progress.say("report: " + unfinished_lines(key, record));
       progress.finished(key);
     };
+    if (!compiled.empty()) {
+      std::vector<RunCase> ahead;
+      for (const auto& [key, cost] : compiled) ahead.push_back({key, cost});
+      // A kernel that does not compile is the matrix case's error to report, not this one's.
+      run_alongside(ahead, o->supervision, jobs,
+                    [&](const std::string& key, const json&) { progress.finished(key); });
+    }
     std::optional<reports::Journal> journal;
     const std::map<std::string, json> records =
         run_supervised(run, o->supervision, run_case, show, journal);

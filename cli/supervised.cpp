@@ -69,6 +69,39 @@ std::string unfinished_lines(const std::string& key, const nlohmann::json& recor
   return lines;
 }
 
+namespace {
+
+// How a run's workers are started: this program again, --worker, limited to --worker-memory.
+reports::WorkerOptions worker_options(const SupervisionOptions& o) {
+  reports::WorkerOptions workers;
+  workers.argv = worker_command();
+  workers.memory_bytes = o.worker_memory_gib > 0.0
+                             ? o.worker_memory_gib * 1024.0 * 1024.0 * 1024.0
+                             : std::max(memory_limit().bytes, 8.0 * 1024 * 1024 * 1024);
+  return workers;
+}
+
+std::vector<reports::SupervisedCase> supervised_cases(const std::vector<const RunCase*>& cases,
+                                                      const SupervisionOptions& o) {
+  std::vector<reports::SupervisedCase> supervised;
+  for (const RunCase* c : cases)
+    supervised.push_back(
+        {c->key, reports::case_deadline(c->cost_seconds, o.deadline_scale, o.deadline_floor)});
+  return supervised;
+}
+
+}  // namespace
+
+void run_alongside(
+    const std::vector<RunCase>& cases, const SupervisionOptions& o, int workers,
+    const std::function<void(const std::string& key, const nlohmann::json& record)>& show) {
+  std::vector<const RunCase*> all;
+  for (const RunCase& c : cases) all.push_back(&c);
+  if (all.empty()) return;
+  const reports::StopSignals stop;
+  reports::supervise_parallel(worker_options(o), supervised_cases(all, o), workers, show);
+}
+
 std::map<std::string, nlohmann::json> run_supervised(
     const SupervisedRun& run, const SupervisionOptions& o,
     const std::function<nlohmann::json(const std::string& key)>& run_here,
@@ -110,16 +143,7 @@ std::map<std::string, nlohmann::json> run_supervised(
         take(c->key, run_here(c->key));
       }
     } else if (!to_run.empty()) {
-      reports::WorkerOptions workers;
-      workers.argv = worker_command();
-      workers.memory_bytes = o.worker_memory_gib > 0.0
-                                 ? o.worker_memory_gib * 1024.0 * 1024.0 * 1024.0
-                                 : std::max(memory_limit().bytes, 8.0 * 1024 * 1024 * 1024);
-      std::vector<reports::SupervisedCase> supervised;
-      for (const RunCase* c : to_run)
-        supervised.push_back(
-            {c->key, reports::case_deadline(c->cost_seconds, o.deadline_scale, o.deadline_floor)});
-      reports::supervise(workers, supervised, take);
+      reports::supervise(worker_options(o), supervised_cases(to_run, o), take);
     }
   } catch (const reports::Interrupted& e) {
     std::fprintf(stderr,

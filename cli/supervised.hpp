@@ -62,6 +62,14 @@ std::map<std::string, nlohmann::json> run_supervised(
     const std::function<void(const std::string& key, const nlohmann::json& record)>& show,
     std::optional<reports::Journal>& journal_out);
 
+// Runs `cases` in up to `workers` workers at once (reports::supervise_parallel), neither
+// journaled nor resumed: work ahead of a run whose results do not depend on it (the GPU kernels
+// a report's matrix will compile). `show(key, record)` is called once a case, one at a time, as
+// they finish. On SIGINT or SIGTERM ends them and throws reports::Interrupted.
+void run_alongside(
+    const std::vector<RunCase>& cases, const SupervisionOptions& o, int workers,
+    const std::function<void(const std::string& key, const nlohmann::json& record)>& show);
+
 // What ended a case without a result, in a line: "CRASH (SIGSEGV) after 2.1 s", then the last
 // lines its worker wrote on its standard error, indented; for a table.
 std::string unfinished_lines(const std::string& key, const nlohmann::json& record);

@@ -67,8 +67,9 @@ CaseGroups case_groups(const std::string& key) {
   const std::vector<std::string> p = split(key);
   if (p[0] == "matrix" && p.size() == 4)  // B/M/S
     return {p[0], p[1], p[2], p[1] + "/" + p[2], p[3]};
-  if (p[0] == "sweep" && p.size() == 3) return {p[0], "", p[2], p[2], p[1]};  // T/M
-  if (p[0] == "scaling" && p.size() == 4)                                     // F/B/M
+  if (p[0] == "compile" && p.size() == 4) return {p[0], p[1], "", p[1], p[3]};  // B/M/S
+  if (p[0] == "sweep" && p.size() == 3) return {p[0], "", p[2], p[2], p[1]};    // T/M
+  if (p[0] == "scaling" && p.size() == 4)                                       // F/B/M
     return {p[0], p[2], p[3], p[2] + "/" + p[3], p[1]};
   // Another kind of case (a conformance case, BACKEND/METHOD/SCENE/...): its first three words.
   const std::string method = p.size() > 1 ? p[1] : "";

@@ -19,10 +19,11 @@
 
 namespace flatmarch::reports {
 
-// A case's place in the calibration: its stage ("matrix", "sweep", "scaling"), its group (the
-// backend; "" for a sweep, which has one), its method, its subgroup (backend/method) and its item
-// (the scene of a matrix case, the surface type of a sweep group, the family of a scaling
-// series). From the case keys of matrix.hpp, sweep.hpp and scaling.hpp.
+// A case's place in the calibration: its stage ("compile", "matrix", "sweep", "scaling"), its
+// group (the backend; "" for a sweep, which has one), its method, its subgroup (backend/method)
+// and its item (the scene of a matrix case, the surface type of a sweep group, the family of a
+// scaling series). From the case keys of matrix.hpp, sweep.hpp and scaling.hpp. A compile case
+// (matrix.hpp) has no method: its programs' cost is the scene's on the backend.
 struct CaseGroups {
   std::string stage, group, method, subgroup, item;
 };

@@ -15,6 +15,7 @@ import html
 import io
 import json
 import math
+import multiprocessing
 import os
 import sys
 
@@ -1075,25 +1076,47 @@ table.recommended img.frame {{ width: 320px; }} ul.legend {{ columns: 2; margin:
 </style></head><body>{body}</body></html>"""
 
 
+# The sections a forked worker draws: (function, arguments) by index, set before the pool forks.
+_SECTION_CALLS = []
+
+
+def _draw_section(index):
+    function, arguments = _SECTION_CALLS[index]
+    return function(*arguments)
+
+
+def draw_sections(calls):
+    """Each (function, arguments) called, on every core at once where there are several (the
+    charts are most of the page's time: 12 s of a 2-core machine's report on one)."""
+    global _SECTION_CALLS
+    workers = min(len(calls), len(os.sched_getaffinity(0)))
+    if workers < 2 or "fork" not in multiprocessing.get_all_start_methods():
+        return [function(*arguments) for function, arguments in calls]
+    _SECTION_CALLS = calls
+    with multiprocessing.get_context("fork").Pool(workers) as pool:
+        return pool.map(_draw_section, range(len(calls)), chunksize=1)
+
+
 def one_machine(results, images, previous=None, previous_path=""):
     cases = results.get("matrix", {}).get("cases", [])
-    sections = [("summary", "verdicts", summary_section(results, cases)),
-                ("ranking", "ranking", ranking_section(results)),
-                ("device", "device time", device_time_section(results, cases)),
-                ("recommended", "recommended choice", recommended_gallery_section(results, images)),
-                ("regression", "regression gate", regression_section(results)),
-                ("previous", "since the earlier run", previous_section(results, previous, previous_path)),
-                ("failures", "failures", failure_section(cases)),
-                ("unfinished", "unfinished", unfinished_section(results)),
-                ("ambiguity", "ambiguity", ambiguity_section(cases)),
-                ("speed", "speed vs accuracy", speed_accuracy_section(cases)),
-                ("gallery", "gallery", gallery_section(results, images)),
-                ("steps", "steps", steps_heatmap_section(cases)),
-                ("sweep", "eps x offset", sweep_section(results.get("sweep", {}))),
-                ("scaling", "scaling", scaling_section(results.get("scaling", {}))),
-                ("definitions", "definitions", definitions_section(results, cases)),
-                ("machine", "machine", "<h2 id=machine>Machine</h2>" +
-                 table(["", ""], fingerprint_rows(results["fingerprint"])))]
+    named = [("summary", "verdicts", summary_section, (results, cases)),
+             ("ranking", "ranking", ranking_section, (results,)),
+             ("device", "device time", device_time_section, (results, cases)),
+             ("recommended", "recommended choice", recommended_gallery_section, (results, images)),
+             ("regression", "regression gate", regression_section, (results,)),
+             ("previous", "since the earlier run", previous_section, (results, previous, previous_path)),
+             ("failures", "failures", failure_section, (cases,)),
+             ("unfinished", "unfinished", unfinished_section, (results,)),
+             ("ambiguity", "ambiguity", ambiguity_section, (cases,)),
+             ("speed", "speed vs accuracy", speed_accuracy_section, (cases,)),
+             ("gallery", "gallery", gallery_section, (results, images)),
+             ("steps", "steps", steps_heatmap_section, (cases,)),
+             ("sweep", "eps x offset", sweep_section, (results.get("sweep", {}),)),
+             ("scaling", "scaling", scaling_section, (results.get("scaling", {}),)),
+             ("definitions", "definitions", definitions_section, (results, cases)),
+             ("machine", "machine", machine_section, (results,))]
+    drawn = draw_sections([(function, arguments) for _, _, function, arguments in named])
+    sections = [(anchor, title, html_) for (anchor, title, _, _), html_ in zip(named, drawn)]
     body = [f"<h1>flatmarch report</h1><p>Measured {esc(results.get('created'))}: timed frames "
             f"{esc(results['options']['size'])} (median of {results['options']['repetitions']} repetitions, "
             f"Google Benchmark), conformance frames {esc(results['options']['conform_size'])}, eps "
@@ -1102,6 +1125,10 @@ def one_machine(results, images, previous=None, previous_path=""):
             "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t, html_ in sections if html_) + "</nav>"]
     body += [html_ for _, _, html_ in sections if html_]
     return PAGE.format(title="flatmarch report", body="\n".join(body))
+
+
+def machine_section(results):
+    return "<h2 id=machine>Machine</h2>" + table(["", ""], fingerprint_rows(results["fingerprint"]))
 
 
 def shards_note(results):

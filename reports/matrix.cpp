@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 #include <optional>
 #include <regex>
@@ -311,6 +312,67 @@ std::map<std::string, Timing> timings(const json& document) {
 std::string matrix_case_key(const std::string& backend, const std::string& method,
                             const std::string& scene) {
   return "matrix/" + backend + "/" + method + "/" + scene;
+}
+
+std::vector<std::pair<std::string, double>> compile_cases(
+    const std::vector<std::pair<std::string, double>>& cases, const std::vector<Scene>& scenes,
+    const std::vector<std::string>& backends) {
+  std::map<std::string, const Scene*> by_name;
+  for (const Scene& s : scenes) by_name[s.name] = &s;
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& c : cases) {
+    // "matrix/BACKEND/METHOD/SCENE"
+    if (c.first.rfind("matrix/", 0) != 0) continue;
+    const size_t b = c.first.find('/', 7);
+    if (b == std::string::npos) continue;
+    const std::string backend = c.first.substr(7, b - 7);
+    if (std::find(backends.begin(), backends.end(), backend) == backends.end()) continue;
+    const size_t m = c.first.find('/', b + 1);
+    if (m == std::string::npos) continue;
+    const auto scene = by_name.find(c.first.substr(m + 1));
+    if (scene == by_name.end()) continue;
+    // A case's three programs on llvmpipe and lavapipe (a 2-core Zen 5, two cases at once):
+    // 0.5-0.6 s in a scene of one room, about 1.8 s in two, 3.7-6.6 s in the cube's six.
+    const double rooms = static_cast<double>(scene->second->polygons.size());
+    out.emplace_back("compile/" + c.first.substr(7), 0.5 + (rooms - 1.0));
+  }
+  return out;
+}
+
+json run_compile_case(const std::string& key, const std::vector<Scene>& scenes,
+                      const MatrixOptions& o,
+                      const std::vector<std::unique_ptr<Backend>>& backends) {
+  // "compile/BACKEND/METHOD/SCENE"
+  const size_t b = key.find('/'), m = b == std::string::npos ? b : key.find('/', b + 1),
+               n = m == std::string::npos ? m : key.find('/', m + 1);
+  if (key.rfind("compile/", 0) != 0 || n == std::string::npos)
+    throw std::invalid_argument("not a compile case: " + key);
+  const std::string backend = key.substr(b + 1, m - b - 1), method = key.substr(m + 1, n - m - 1),
+                    scene_name = key.substr(n + 1);
+  const auto scene = std::find_if(scenes.begin(), scenes.end(),
+                                  [&](const Scene& s) { return s.name == scene_name; });
+  const std::optional<Method> parsed = parse_method(method);
+  if (scene == scenes.end() || !parsed)
+    throw std::invalid_argument("no such scene or method here: " + key);
+  const auto it =
+      std::find_if(backends.begin(), backends.end(),
+                   [&](const std::unique_ptr<Backend>& x) { return x->name() == backend; });
+  if (it == backends.end()) throw std::invalid_argument("no such backend here: " + key);
+  const Backend& on = **it;
+  MarchParams params = o.params;
+  params.method = *parsed;
+  const auto start = std::chrono::steady_clock::now();
+  // The programs the case runs: its whole frames (the conformance frame, the timed case's
+  // first), its frames of the colour alone, a probe ray's trace; all from its camera.
+  constexpr int kPixels = 8;
+  on.render(*scene, scene->camera, kPixels, kPixels, params, {});
+  on.render_colour(*scene, scene->camera, kPixels, kPixels, params, {});
+  const double yaw = scene->camera.yaw_deg * 3.14159265358979323846 / 180.0;
+  on.trace(*scene,
+           {scene->camera.polygon, scene->camera.position, Vec3(std::cos(yaw), std::sin(yaw), 0.0)},
+           params, 4);
+  return {
+      {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
 }
 
 MatrixBackends matrix_backends(const MatrixOptions& o) {

@@ -51,6 +51,24 @@ bool matrix_measures(const MatrixOptions& o, const std::string& backend, const s
 std::string matrix_case_key(const std::string& backend, const std::string& method,
                             const std::string& scene);
 
+// The kernels of the matrix's GPU cases, compiled ahead (a report's "compile" stage). A GPU
+// backend's case compiles three programs (its whole frame, its frame of the colour alone, the
+// trace of a probe ray) on one thread while the other cores wait: 147 s of a 2-core machine's
+// first report on llvmpipe and lavapipe. Compiled first, several cases at once, each in a frame
+// of 8x8 pixels and one trace, they are in the driver's disk cache when the case runs.
+// The compile cases of `cases` (matrix cases among others, by key) whose backend is one of
+// `backends`: "compile/BACKEND/METHOD/SCENE", each with its expected seconds on one thread (more
+// rooms, more code), in the order of `cases`.
+std::vector<std::pair<std::string, double>> compile_cases(
+    const std::vector<std::pair<std::string, double>>& cases, const std::vector<Scene>& scenes,
+    const std::vector<std::string>& backends);
+// Compiles a compile case's programs on its backend, one of `backends` (a worker's matrix
+// backends). Returns {"seconds"}; throws std::invalid_argument for a key that names no scene,
+// method or backend here.
+nlohmann::json run_compile_case(const std::string& key, const std::vector<Scene>& scenes,
+                                const MatrixOptions& o,
+                                const std::vector<std::unique_ptr<Backend>>& backends);
+
 // Called with a line of progress: what was done, how many of how many.
 using MatrixProgress = std::function<void(const std::string& line, int done, int total)>;
 

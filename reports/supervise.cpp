@@ -16,10 +16,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <iostream>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <stdexcept>
+#include <thread>
 
 extern char** environ;
 
@@ -300,12 +303,15 @@ double case_deadline(double cost_seconds, double scale, double floor_seconds) {
   return std::max(floor_seconds, scale * cost_seconds);
 }
 
-void supervise(const WorkerOptions& options, const std::vector<SupervisedCase>& cases,
-               const std::function<void(const std::string& key, const json& record)>& done) {
-  if (options.argv.empty()) throw std::invalid_argument("supervise: no worker command");
-  const IgnoreSigpipe ignore;
+namespace {
+
+// supervise()'s loop, over the cases `next` hands out (null: no more), SIGPIPE ignored already.
+void supervise_from(const WorkerOptions& options,
+                    const std::function<const SupervisedCase*()>& next,
+                    const std::function<void(const std::string& key, const json& record)>& done) {
   std::optional<Worker> worker;
-  for (const SupervisedCase& c : cases) {
+  while (const SupervisedCase* next_case = next()) {
+    const SupervisedCase& c = *next_case;
     bool fresh = false;
     if (!worker) {
       worker.emplace(options);
@@ -357,6 +363,50 @@ void supervise(const WorkerOptions& options, const std::vector<SupervisedCase>& 
     done(c.key, record);
   }
   if (worker) worker->finish(10.0);
+}
+
+}  // namespace
+
+void supervise(const WorkerOptions& options, const std::vector<SupervisedCase>& cases,
+               const std::function<void(const std::string& key, const json& record)>& done) {
+  if (options.argv.empty()) throw std::invalid_argument("supervise: no worker command");
+  const IgnoreSigpipe ignore;
+  size_t k = 0;
+  supervise_from(
+      options, [&]() { return k < cases.size() ? &cases[k++] : nullptr; }, done);
+}
+
+void supervise_parallel(
+    const WorkerOptions& options, const std::vector<SupervisedCase>& cases, int workers,
+    const std::function<void(const std::string& key, const json& record)>& done) {
+  if (options.argv.empty()) throw std::invalid_argument("supervise: no worker command");
+  if (workers < 1) throw std::invalid_argument("supervise_parallel: no worker");
+  // Once, around every thread: an IgnoreSigpipe of each would restore the others' state.
+  const IgnoreSigpipe ignore;
+  std::mutex mutex;  // over `k`, `done` and `failure`
+  size_t k = 0;
+  std::exception_ptr failure;
+  const auto next = [&]() -> const SupervisedCase* {
+    const std::lock_guard<std::mutex> lock(mutex);
+    return !failure && k < cases.size() ? &cases[k++] : nullptr;
+  };
+  const auto take = [&](const std::string& key, const json& record) {
+    const std::lock_guard<std::mutex> lock(mutex);
+    done(key, record);
+  };
+  std::vector<std::thread> threads;
+  const size_t count = std::min(static_cast<size_t>(workers), cases.size());
+  for (size_t t = 0; t < count; ++t)
+    threads.emplace_back([&] {
+      try {
+        supervise_from(options, next, take);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  if (failure) std::rethrow_exception(failure);
 }
 
 std::string unfinished_summary(const json& record, bool loud) {

@@ -84,6 +84,15 @@ void supervise(
     const WorkerOptions& options, const std::vector<SupervisedCase>& cases,
     const std::function<void(const std::string& key, const nlohmann::json& record)>& done);
 
+// supervise() with up to `workers` workers at once, each taking the next case as it finishes
+// one (work that may overlap: the GPU kernels compiled ahead of a report's matrix, whose timings
+// would not bear another process beside them). `done` is called once a case, one call at a time,
+// in the order the cases finish. The first error of any thread (Interrupted among them) is
+// thrown once every worker has stopped.
+void supervise_parallel(
+    const WorkerOptions& options, const std::vector<SupervisedCase>& cases, int workers,
+    const std::function<void(const std::string& key, const nlohmann::json& record)>& done);
+
 // The worker's side. Sets its own address-space limit as the parent asked (through the
 // environment: FLATMARCH_WORKER_MEMORY; not in a sanitizer build, whose shadow memory needs
 // terabytes of address space), and reads the keys, calling `run(key)` for each and writing its

@@ -34,6 +34,13 @@ TEST(CaseGroups, NameTheBackendItsMethodAndTheItemOfEachKindOfCase) {
   EXPECT_EQ(c.group, "scalar");
   EXPECT_EQ(c.subgroup, "scalar/relaxed");
   EXPECT_EQ(c.item, "polygon_n");
+  // A compile case's programs cost the scene's on the backend, whatever the method.
+  const CaseGroups k = case_groups("compile/vulkan/sphere/cube");
+  EXPECT_EQ(k.stage, "compile");
+  EXPECT_EQ(k.group, "vulkan");
+  EXPECT_EQ(k.method, "");
+  EXPECT_EQ(k.subgroup, "vulkan");
+  EXPECT_EQ(k.item, "cube");
 }
 
 std::vector<std::string> keys_of(const Cases& cases) {

@@ -46,6 +46,7 @@ class VulkanBackend final : public Backend {
   }
   std::vector<Precision> precisions() const override { return {Precision::f32}; }
   std::optional<DeviceInfo> device() const override;
+  bool compiles_per_scene() const override { return true; }
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;
   Frame render_colour(const Scene& scene, const Camera& camera, int width, int height,

@@ -9,6 +9,7 @@
 
 #include "output/image_io.hpp"
 #include "reports/gallery.hpp"
+#include "reports/matrix.hpp"
 #include "reports/report.hpp"
 #include "reports/surfaces.hpp"
 #include "scene/load.hpp"
@@ -40,6 +41,35 @@ TEST(SurfaceType, ClassifiesTheGalleryByItsHazards) {
   EXPECT_EQ(surface_type(load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "conformance" / "scenes" /
                                     "dilation.json")),
             "dilation");
+}
+
+// The GPU kernels compiled ahead of the matrix: a case for each matrix case of a backend that
+// compiles per scene, in the matrix's order, dearer the more rooms its scene has; a compile case
+// runs on its backend, and a key that names nothing here is refused.
+TEST(CompileCases, OneForEachMatrixCaseOfTheCompilingBackends) {
+  const std::vector<Scene> scenes = {gallery("torus"), gallery("cube")};
+  const std::vector<std::pair<std::string, double>> cases = {
+      {"matrix/opengl/sphere/cube", 1.0},   {"matrix/scalar/sphere/cube", 1.0},
+      {"sweep/translation/sphere", 1.0},    {"matrix/vulkan/analytic/torus", 1.0},
+      {"matrix/opengl/relaxed/torus", 1.0}, {"matrix/opengl/sphere/nowhere", 1.0}};
+  const auto compiled = compile_cases(cases, scenes, {"opengl", "vulkan"});
+  ASSERT_EQ(compiled.size(), 3u);
+  EXPECT_EQ(compiled[0].first, "compile/opengl/sphere/cube");
+  EXPECT_EQ(compiled[1].first, "compile/vulkan/analytic/torus");
+  EXPECT_EQ(compiled[2].first, "compile/opengl/relaxed/torus");
+  EXPECT_GT(compiled[0].second, 5.0 * compiled[1].second);  // six rooms against one
+  EXPECT_EQ(compiled[1].second, compiled[2].second);
+  EXPECT_TRUE(compile_cases(cases, scenes, {}).empty());
+
+  MatrixOptions o;
+  std::vector<std::unique_ptr<Backend>> backends;
+  backends.push_back(make_backend("scalar", {}));
+  const nlohmann::json r = run_compile_case("compile/scalar/analytic/torus", scenes, o, backends);
+  EXPECT_GE(r.at("seconds").get<double>(), 0.0);
+  for (const char* bad :
+       {"compile/opengl/analytic/torus", "compile/scalar/analytic/nowhere",
+        "compile/scalar/no_method/torus", "compile/scalar", "matrix/scalar/analytic/torus"})
+    EXPECT_THROW(run_compile_case(bad, scenes, o, backends), std::invalid_argument) << bad;
 }
 
 TEST(GeneratedSurfaces, RegularPolygonHasTheGenusOfItsEdgeCount) {
