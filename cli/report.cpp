@@ -134,6 +134,8 @@ void add_report(CLI::App& app) {
                 sweep_backend;
     std::string baseline, write_baseline, previous, shard, python = default_python();
     int repetitions = 0, compile_jobs = -1;
+    // A worker of the compile stage: the matrix's backends it makes (those that compile).
+    std::vector<std::string> compile_worker;
     double min_time = 0.02;
     bool full = false, all_scenes = false, no_sweep = false, no_scaling = false, no_html = false,
          quiet = false;
@@ -210,6 +212,7 @@ void add_report(CLI::App& app) {
                   "method) before the matrix, this many at once, into the driver's disk cache "
                   "(default: one per core, at most 8; 0: none, each case compiles its own)")
       ->check(CLI::Range(0, 64));
+  cmd->add_option("--compile-worker", o->compile_worker)->group("");  // hidden
   cmd->add_option("--progress-log", o->progress_log,
                   "Write a JSON line per finished case (its stage, seconds and the stage's "
                   "estimate of the time left then) to this file: bench/eta_check.py judges the "
@@ -250,6 +253,8 @@ void add_report(CLI::App& app) {
                          joined(r.matrix.backends) + ")");
       r.matrix.backends.erase(at);
     }
+    // A compile worker makes no backend it does not compile on (a browser's start above all).
+    if (!o->compile_worker.empty()) r.matrix.backends = o->compile_worker;
     for (const std::string& b : r.matrix.backends) make_kernel_backend(b, o->backend_options);
     std::tie(r.matrix.width, r.matrix.height) =
         parse_size("--size", o->size.empty() ? (o->full ? "640x360" : "256x144") : o->size);
@@ -454,7 +459,9 @@ void add_report(CLI::App& app) {
       std::vector<RunCase> ahead;
       for (const auto& [key, cost] : compiled) ahead.push_back({key, cost});
       // A kernel that does not compile is the matrix case's error to report, not this one's.
-      run_alongside(ahead, o->supervision, jobs,
+      std::vector<std::string> only;
+      for (const std::string& b : compiling) only.insert(only.end(), {"--compile-worker", b});
+      run_alongside(ahead, o->supervision, jobs, only,
                     [&](const std::string& key, const json&) { progress.finished(key); });
     }
     std::optional<reports::Journal> journal;

@@ -94,12 +94,15 @@ std::vector<reports::SupervisedCase> supervised_cases(const std::vector<const Ru
 
 void run_alongside(
     const std::vector<RunCase>& cases, const SupervisionOptions& o, int workers,
+    const std::vector<std::string>& worker_args,
     const std::function<void(const std::string& key, const nlohmann::json& record)>& show) {
   std::vector<const RunCase*> all;
   for (const RunCase& c : cases) all.push_back(&c);
   if (all.empty()) return;
+  reports::WorkerOptions workers_options = worker_options(o);
+  workers_options.argv.insert(workers_options.argv.end(), worker_args.begin(), worker_args.end());
   const reports::StopSignals stop;
-  reports::supervise_parallel(worker_options(o), supervised_cases(all, o), workers, show);
+  reports::supervise_parallel(workers_options, supervised_cases(all, o), workers, show);
 }
 
 std::map<std::string, nlohmann::json> run_supervised(

@@ -64,10 +64,12 @@ std::map<std::string, nlohmann::json> run_supervised(
 
 // Runs `cases` in up to `workers` workers at once (reports::supervise_parallel), neither
 // journaled nor resumed: work ahead of a run whose results do not depend on it (the GPU kernels
-// a report's matrix will compile). `show(key, record)` is called once a case, one at a time, as
+// a report's matrix will compile). Each worker's command line ends with `worker_args` (so that it
+// makes what it needs, no more). `show(key, record)` is called once a case, one at a time, as
 // they finish. On SIGINT or SIGTERM ends them and throws reports::Interrupted.
 void run_alongside(
     const std::vector<RunCase>& cases, const SupervisionOptions& o, int workers,
+    const std::vector<std::string>& worker_args,
     const std::function<void(const std::string& key, const nlohmann::json& record)>& show);
 
 // What ended a case without a result, in a line: "CRASH (SIGSEGV) after 2.1 s", then the last
