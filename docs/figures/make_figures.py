@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""The figures of docs/: one Markdown page per benchmark JSON file in docs/figures/data/.
+"""The figures of docs/: one Markdown page per benchmark JSON file in bench/results/.
 
-Each data/NAME.json is what a Google Benchmark program writes with --benchmark_out=FILE
+Each bench/results/NAME.json is what a Google Benchmark program writes with --benchmark_out=FILE
 --benchmark_out_format=json; it becomes NAME.md beside this script. A page begins with the
 machine and the date the JSON records (the CPU model, instruction set and devices are there when
 the program added flatmarch's fingerprint to its context: a run with --shard=I/N does), then a
@@ -38,33 +38,33 @@ KNOWN = {
         "the SIMD backend per scene, method and instruction set, beside the scalar backend",
         ["build/bench/simd_bench --shard=1/1",
          "--benchmark_repetitions=3 --benchmark_report_aggregates_only=true",
-         "--benchmark_out=docs/figures/data/simd_bench.json --benchmark_out_format=json"]),
+         "--benchmark_out=bench/results/simd_bench.json --benchmark_out_format=json"]),
     "kernel_bench": (
         "every kernel backend and method on the gallery at 320x180: rays a second and steps",
         ["build/bench/kernel_bench --shard=1/1",
          "--benchmark_repetitions=3 --benchmark_report_aggregates_only=true",
-         "--benchmark_out=docs/figures/data/kernel_bench.json --benchmark_out_format=json"]),
+         "--benchmark_out=bench/results/kernel_bench.json --benchmark_out_format=json"]),
     "gpu_bench": (
         "the OpenGL and Vulkan backends side by side, a frame's fixed cost and time on the device",
         ["build/bench/gpu_bench --shard=1/1 --benchmark_filter='^(opengl|vulkan|fixed)/.*/640x360'",
          "--benchmark_repetitions=3 --benchmark_report_aggregates_only=true",
-         "--benchmark_out=docs/figures/data/gpu_bench.json --benchmark_out_format=json"]),
+         "--benchmark_out=bench/results/gpu_bench.json --benchmark_out_format=json"]),
     "web_bench": (
         "the exported page in headless Chromium, beside the original app's shaders",
         ["build/bench/web_bench --shard=1/1 --peer-shaders=DIR --size=320x180",
          "--benchmark_repetitions=3 --benchmark_report_aggregates_only=true",
-         "--benchmark_out=docs/figures/data/web_bench.json --benchmark_out_format=json"]),
+         "--benchmark_out=bench/results/web_bench.json --benchmark_out_format=json"]),
     "startup_bench": (
         "how long each command takes to start and do a small piece of work",
         ["build/bench/startup_bench --shard=1/1",
          "--benchmark_repetitions=20 --benchmark_report_aggregates_only=true",
-         "--benchmark_out=docs/figures/data/startup_bench.json --benchmark_out_format=json"]),
+         "--benchmark_out=bench/results/startup_bench.json --benchmark_out_format=json"]),
     "vector_width_bench": (
         "float additions in vectors of each width on one core: whether 512-bit operations run at "
         "full width",
         ["build/bench/vector_width_bench",
          "--benchmark_repetitions=3 --benchmark_report_aggregates_only=true",
-         "--benchmark_out=docs/figures/data/vector_width_bench.json --benchmark_out_format=json"]),
+         "--benchmark_out=bench/results/vector_width_bench.json --benchmark_out_format=json"]),
 }
 
 # Keys of a benchmark entry that are not user counters.
@@ -84,12 +84,15 @@ def number(v):
         return "-"
     if not isinstance(v, (int, float)):
         return str(v)
-    a = abs(v)
-    for scale, suffix in ((1e9, " G"), (1e6, " M"), (1e4, " k")):
-        if a >= scale:
+    a = float(f"{abs(v):.3g}")  # as it will print: 999 999 is 1.00 M, not 1000 k
+    # From 10 000 on in thousands (10.0 k, 934 k), so that no figure has five digits.
+    for at, scale, suffix in ((1e9, 1e9, " G"), (1e6, 1e6, " M"), (1e4, 1e3, " k")):
+        if a >= at:
             return number(v / scale) + suffix
     if a == 0:
         return "0"
+    if a < 1e-3:  # 6.08e-05: written out, its run of zeros reads as a hash to a grep
+        return f"{v:.3g}"
     if float(v).is_integer() and a < 1e4:
         return str(int(v))
     decimals = max(0, 2 - int(math.floor(math.log10(a))))
@@ -219,7 +222,7 @@ def page(name, path):
         medians = any(b.get("aggregate_name") == "median" for b in json.load(f)["benchmarks"])
     runs = list(runs_by_name.values())
     what = KNOWN.get(name, ("",))[0]
-    lines = [f"{MARK}data/{name}.json; run it again rather than edit this -->",
+    lines = [f"{MARK}bench/results/{name}.json; run it again rather than edit this -->",
              f"# {name}" + (f": {what}" if what else ""), ""]
     machine, summary = machine_lines(context, runs)
     lines += machine + [""]
@@ -239,9 +242,9 @@ def prose(text):
 def waiting_page(name):
     what, command = KNOWN[name]
     return "\n".join([
-        f"{MARK}data/{name}.json, which is not there yet; run it again rather than edit this -->",
+        f"{MARK}bench/results/{name}.json, which is not there yet; run it again rather than edit this -->",
         f"# {name}: {what}", "",
-        prose(f"No measurement yet: `docs/figures/data/{name}.json` is not there. Make it on the "
+        prose(f"No measurement yet: `bench/results/{name}.json` is not there. Make it on the "
               "machine to be measured (a Release build gives the figures a user sees), then run "
               "`python3 docs/figures/make_figures.py`:"), "",
         "```sh", " \\\n  ".join(command), "```", ""])
@@ -252,8 +255,8 @@ def main():
         description=__doc__.split("\n\n")[0],
         epilog="With no JSON in the data folder every known program's page says how to make its "
                "JSON, and the script says so.")
-    parser.add_argument("--data", default=os.path.join(HERE, "data"),
-                        help="folder of benchmark JSON files (default: data/ beside this script)")
+    parser.add_argument("--data", default=os.path.join(HERE, "..", "..", "bench", "results"),
+                        help="folder of benchmark JSON files (default: bench/results/)")
     parser.add_argument("--out", default=HERE,
                         help="folder for the pages (default: this script's folder)")
     args = parser.parse_args()
@@ -277,13 +280,13 @@ def main():
     if not inputs:
         print(f"make_figures.py: {args.data} holds no *.json: every page says which command "
               "makes its JSON; put the JSON there and run this again")
-    lines = [f"{MARK}data/; run it again rather than edit this -->",
+    lines = [f"{MARK}bench/results/; run it again rather than edit this -->",
              "# Figures", "",
              prose("Measured figures for the pages of docs/, each page made from one benchmark JSON file "
-             "in `data/` by `python3 docs/figures/make_figures.py`, which prints the machine and "
+             "in `bench/results/` by `python3 docs/figures/make_figures.py`, which prints the machine and "
              "the date it was measured. A figure belongs to its machine: run the command on "
              "yours to see your own."), ""]
-    lines += ["No JSON in `data/` yet." if not inputs else f"{len(inputs)} files in `data/`.", ""]
+    lines += ["No JSON in `bench/results/` yet." if not inputs else f"{len(inputs)} files in `bench/results/`.", ""]
     lines += sorted(index) + [""]
     written["README"] = "\n".join(lines)
 
