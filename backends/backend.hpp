@@ -12,6 +12,8 @@
 #include <variant>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "kernels/constants.hpp"
 #include "kernels/march_params.hpp"
 #include "scene/scene.hpp"
@@ -209,6 +211,19 @@ struct BackendOptions {
   bool validation = false;
 };
 
+// What a backend that marches rays in vector lanes measures of them for a case (the SIMD
+// backend): its lanes per packet; of the lanes a packet step could have used, how many did work
+// (summed over a frame's passes); the most lane-steps a second it makes on the case (one room's
+// step on full packets on all its threads; 0: no step to time); and its rays a second on one
+// thread, its instruction set the same (the median of three frames of the colour after one
+// untimed; 0 where it runs one thread already): the numerator of its lane efficiency.
+struct LaneFigures {
+  int lanes = 0;
+  int64_t active = 0, slots = 0;
+  double peak_steps_per_s = 0.0;
+  double one_thread_rays_per_s = 0.0;
+};
+
 // Called now and then during long work with the fraction done, in [0, 1].
 using Progress = std::function<void(double)>;
 
@@ -254,6 +269,14 @@ class Backend {
   // SwiftShader's threads after the case, slowing the next cases of the other backends). The
   // next frame opens what it needs again.
   virtual void rest() const {}
+  // Its lanes' figures for a case (LaneFigures; the peak timed for about `peak_seconds`); none
+  // from a backend without lanes.
+  virtual std::optional<LaneFigures> lane_figures(const Scene& scene, const Camera& camera,
+                                                  int width, int height, const MarchParams& params,
+                                                  double peak_seconds) const {
+    (void)scene, (void)camera, (void)width, (void)height, (void)params, (void)peak_seconds;
+    return std::nullopt;
+  }
 };
 
 // ---- The registry -----------------------------------------------------------------------------
@@ -268,7 +291,28 @@ struct BackendOption {
   std::string help;
 };
 
-// A backend as the project's lists know it.
+// What a case of a backend costs, as the shard planner and the time-left estimate price it
+// before any case has run (reports/shard.hpp): seconds on a 2-core Zen 5.
+struct BackendCost {
+  double frame_seconds = 0.01;   // a 160x90 frame of sphere tracing (a tenth of it analytic)
+  double startup_seconds = 0.0;  // a conformance case's start beyond its frames (a browser's page)
+  // What a timed case adds beyond its frames (the SIMD backend's lane figures), from a frame's
+  // seconds and the minimum time a benchmark runs; none if null.
+  std::function<double(double frame_seconds, double min_time)> extra_timed_seconds{};
+};
+
+// `flatmarch shader`'s request of a backend that runs a GLSL shader of its own: the trace variant
+// or the whole frame's, in the kernel's software or GPU shape.
+struct ShaderRequest {
+  bool trace = false;
+  KernelShape shape = KernelShape::software;
+};
+
+// The help of --kernel-shape, which the GPU backends' entries share.
+extern const char* const kKernelShapeHelp;
+
+// A backend as the project's lists know it: what the command line, the report, the shard planner,
+// the fingerprint and the tests ask of it, so that none of them names a backend.
 struct BackendEntry {
   std::string name;
   // Runs the march kernel: the conformance suite, the report and the benchmarks measure it
@@ -285,7 +329,45 @@ struct BackendEntry {
   // Why its results are wrong on purpose, if they are (the test programs' `faulty` backend):
   // conformance must fail it on every case; the contract and stability tests skip it, saying so.
   std::string wrong_on_purpose{};
+  // The methods the gallery's conformance test runs it on, where its every case costs much
+  // (webgl: a browser's page; `flatmarch conform` measures the rest); empty: every method.
+  std::vector<Method> gallery_test_methods{};
+  // Its cost, for the shard planner (BackendCost).
+  BackendCost cost{};
+  // The conformance tests run its cases in one process with the other backends of this batch
+  // (tests/CMakeLists.txt's BATCH, made from each backend's flatmarch_add_backend): "kernels",
+  // whose cases share each scene's truth, or one of its own ("webgl": it starts a browser).
+  std::string test_batch = "kernels";
+  // A CPU backend that runs the kernel, by speed (0: not one): the fastest built and available is
+  // `render`'s default and the report's quick sweep's; the slowest, the reference, its fallback.
+  int cpu_rank = 0;
+  // Why the default report measures it on a sample of its cases where its device draws in
+  // software ("its WebGL draws in software here"); empty: on every case wherever it runs.
+  std::string software_sample_why{};
+  // Checks the options it takes (BackendOptions); an error to show, or empty.
+  std::function<std::string(const BackendOptions&)> check_options{};
+  // Adds what the machine's fingerprint says of it (its devices, instruction sets, libraries).
+  std::function<void(nlohmann::json& fingerprint)> fingerprint{};
+  // Its rows of the report's machine table (a label and a text), and its part of the machine's
+  // one-line description ("; Vulkan: NAME"), from a fingerprint.
+  std::function<std::vector<std::pair<std::string, std::string>>(const nlohmann::json&)>
+      fingerprint_rows{};
+  std::function<std::string(const nlohmann::json&)> describe_machine{};
+  // `flatmarch backends`: adds to its JSON entry (its devices, its instruction sets), and the
+  // text printed after the table from that entry.
+  std::function<void(const Backend&, nlohmann::json& listing)> list{};
+  std::function<std::string(const nlohmann::json& listing)> list_text{};
+  // `flatmarch shader`: the GLSL it runs for a scene's whole frames (its kernel specialised on the
+  // scene, with the tables baked in), and its compiler, which returns what compiled it (a
+  // renderer's name) or throws kernel::ShaderError. None if null: it runs no shader of its own.
+  std::function<std::string(const Scene&, const MarchParams&, const ShaderRequest&)> shader{};
+  std::function<std::string(const Backend&, const std::string& source, const ShaderRequest&)>
+      compile_shader{};
 };
+
+// The entries a build has, in order (backends/registered.cpp, made by CMake from the backends'
+// folders the build's options keep: oracle, scalar, then simd, opengl, vulkan, webgl).
+std::vector<BackendEntry> built_in_backends();
 
 // The registered backends: the built-in ones, then any a program added.
 const std::vector<BackendEntry>& backend_registry();
@@ -298,6 +380,11 @@ std::vector<std::string> backend_names();
 std::vector<std::string> kernel_backend_names();
 // The registry's entry of that name; null if there is none.
 const BackendEntry* find_backend_entry(const std::string& name);
+// The CPU backends that run the kernel, fastest first (BackendEntry::cpu_rank); the fastest of
+// them that runs here with `options`; and the reference one (the slowest: scalar).
+std::vector<std::string> cpu_backend_names();
+std::string fastest_cpu_backend(const BackendOptions& options);
+std::string reference_cpu_backend();
 
 // All registered backends, available here or not, with default options.
 const std::vector<std::unique_ptr<Backend>>& backends();

@@ -5,7 +5,8 @@ For each size, scene and method: milliseconds a frame on each backend, the ratio
 backend's time to the first's, and the geometric mean of the ratios per size and method. Medians
 when the run has repetitions. Prints a Markdown table.
 
-Usage: python3 bench/side_by_side.py gpu.json [--backends opengl vulkan]
+Usage: python3 bench/side_by_side.py gpu.json [--backends FIRST SECOND]
+(default: the first two backends the file times, in its order)
 """
 import argparse
 import json
@@ -31,16 +32,25 @@ def milliseconds(run):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("json")
-    parser.add_argument("--backends", nargs=2, default=["opengl", "vulkan"])
+    parser.add_argument("--backends", nargs=2, metavar=("FIRST", "SECOND"),
+                        help="the two backends to compare (default: the first two the file times)")
     args = parser.parse_args()
-    first, second = args.backends
     cases = defaultdict(dict)  # (size, method, scene) -> {backend: ms}
+    timed = []  # the backends, in the file's order
     pattern = re.compile(r"^(\w+)/(\w+)/(\w+)/(\d+x\d+)(?:/(?:real|manual)_time)?$")
     for name, run in figures(args.json).items():
         m = pattern.match(name)
         if m:
             backend, method, scene, size = m.groups()
             cases[(size, method, scene)][backend] = milliseconds(run)
+            if backend not in timed:
+                timed.append(backend)
+    if args.backends:
+        first, second = args.backends
+    elif len(timed) >= 2:
+        first, second = timed[:2]
+    else:
+        parser.error(f"{args.json} times {len(timed)} backend(s): two are needed (--backends)")
     ratios = defaultdict(list)
     print(f"| size | method | scene | {first} ms | {second} ms | {second} / {first} |")
     print("| --- | --- | --- | --- | --- | --- |")

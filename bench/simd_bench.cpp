@@ -49,8 +49,12 @@ void simd_frame(benchmark::State& state, const Scene* scene, MarchParams params,
     benchmark::DoNotOptimize(frame.rgb.data());
   }
   bench::frame_counters(state, frame);
-  reports::simd_counters(state, frame, lanes,
-                         simd.peak_lane_steps(*scene, scene->camera, kWidth, kHeight, params));
+  reports::lane_counters(
+      state, frame,
+      {.lanes = simd.lanes(),
+       .active = lanes.active,
+       .slots = lanes.slots,
+       .peak_steps_per_s = simd.peak_lane_steps(*scene, scene->camera, kWidth, kHeight, params)});
   state.counters["lanes"] = simd.lanes();
 }
 

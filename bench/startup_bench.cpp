@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "backends/backend.hpp"
 #include "bench/gallery.hpp"
 
 extern char** environ;
@@ -61,16 +62,24 @@ int main(int argc, char** argv) {
   scratch = (std::filesystem::temp_directory_path() / "flatmarch_startup_bench").string();
   std::filesystem::create_directories(scratch);
   const std::string torus = kSource + "/scenes/torus.json";
-  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+  std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
       {"help", {"--help"}},
       {"inspect", {"inspect", torus}},
       {"trace", {"trace", torus, "--from", "1,1,1", "--dir", "3,1,0"}},
-      {"plan", {"plan", torus, "-o", scratch + "/t.svg"}},
-      {"render_simd_320x180_png",
-       {"render", torus, "--backend", "simd", "--size", "320x180", "-o", scratch + "/t.png"}},
-      {"render_opengl_320x180_png",
-       {"render", torus, "--backend", "opengl", "--size", "320x180", "-o", scratch + "/g.png"}},
-      {"backends", {"backends"}}};
+      {"plan", {"plan", torus, "-o", scratch + "/t.svg"}}};
+  // A render on the fastest CPU backend the build has, and on its first that compiles a shader
+  // of its own (a GPU backend: its driver's start and the compile).
+  std::vector<std::string> render = {flatmarch::cpu_backend_names().front()};
+  for (const flatmarch::BackendEntry& e : flatmarch::backend_registry())
+    if (e.shader) {
+      render.push_back(e.name);
+      break;
+    }
+  for (const std::string& b : render)
+    cases.push_back(
+        {"render_" + b + "_320x180_png",
+         {"render", torus, "--backend", b, "--size", "320x180", "-o", scratch + "/" + b + ".png"}});
+  cases.push_back({"backends", {"backends"}});
   for (const auto& [name, args] : cases)
     flatmarch::bench::add("startup/" + name, command, args)
         ->Unit(benchmark::kMillisecond)

@@ -20,7 +20,6 @@
 #include <variant>
 
 #include "backends/oracle/oracle.hpp"
-#include "backends/simd/simd.hpp"
 #include "kernels/compile.hpp"
 #include "output/image_library.hpp"
 #include "scene/load.hpp"
@@ -226,11 +225,10 @@ void check_backend_options(const BackendOptions& options) {
   if (options.threads < 0) throw UsageError("--threads: must be 0 (all cores) or more");
   if (const std::string e = kernel_shape_error(options.kernel_shape); !e.empty())
     throw UsageError(e);
-  const std::vector<std::string> isas = simd::isa_names(false);
-  if (!options.isa.empty() && std::find(isas.begin(), isas.end(), options.isa) == isas.end()) {
-    throw UsageError("--isa: unknown instruction set \"" + options.isa + "\" (" + joined(isas) +
-                     ")");
-  }
+  for (const BackendEntry& e : backend_registry())
+    if (e.check_options)
+      if (const std::string error = e.check_options(options); !error.empty())
+        throw UsageError(error);
 }
 
 Precision parse_precision(const std::string& text) {

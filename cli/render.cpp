@@ -30,7 +30,7 @@ void add_render(CLI::App& app) {
                 "AOV says which failure each is");
   // The exact method and the fastest; the paper's sphere tracing is --method sphere.
   o->march.default_method = "analytic";
-  o->march.add_to(*cmd, "simd", "scalar");
+  o->march.add_to(*cmd, cpu_backend_names().front(), reference_cpu_backend());
   o->camera.add_to(*cmd);
   cmd->callback([o] {
     const auto [w, h] = parse_size("--size", o->size);

@@ -278,12 +278,13 @@ void add_report(CLI::App& app) {
     // The CPU backend of the quick sweep and scaling series: the SIMD backend where the report
     // measures it and it runs, else the scalar one.
     const std::string cpu_backend = [&] {
-      const auto measured = [&](const char* name) {
-        return std::find(r.matrix.backends.begin(), r.matrix.backends.end(), name) !=
-               r.matrix.backends.end();
-      };
-      const std::unique_ptr<Backend> simd = make_backend("simd", o->backend_options);
-      return measured("simd") && simd && simd->availability().available ? "simd" : "scalar";
+      for (const std::string& name : cpu_backend_names()) {
+        const bool measured = std::find(r.matrix.backends.begin(), r.matrix.backends.end(), name) !=
+                              r.matrix.backends.end();
+        if (measured && make_backend(name, o->backend_options)->availability().available)
+          return name;
+      }
+      return reference_cpu_backend();
     }();
     r.sweep_enabled = !o->no_sweep;
     r.sweep_all_scenes = o->full;
@@ -345,7 +346,8 @@ void add_report(CLI::App& app) {
     // time a case (4.8 s against 0.3-0.6 s on a 2-core Zen 5, a prism's 20 s): measured on a
     // sample unless asked for all.
     for (const auto& b : backends->available) {
-      if (o->full || o->all_scenes || b->name() != "webgl") continue;
+      const BackendEntry* entry = find_backend_entry(b->name());
+      if (o->full || o->all_scenes || !entry || entry->software_sample_why.empty()) continue;
       const std::optional<DeviceInfo> device = b->device();
       if (!device || !device->software) continue;
       r.matrix.sampled_backends.push_back(b->name());
@@ -354,7 +356,7 @@ void add_report(CLI::App& app) {
       for (size_t k = 0; k < chosen.size(); ++k)
         r.matrix.sample_cases.push_back(chosen[k] + "/" +
                                         to_string(r.matrix.methods[k % r.matrix.methods.size()]));
-      r.matrix.sample_why = "its WebGL draws in software here (" + device->name +
+      r.matrix.sample_why = entry->software_sample_why + " (" + device->name +
                             "): the simplest scene of each surface type, with one method each, "
                             "the methods in turn; --all-scenes or --full measures every case";
     }

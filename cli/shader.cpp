@@ -1,17 +1,27 @@
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
-#include "backends/opengl/gl_kernel.hpp"
-#include "backends/opengl/opengl.hpp"
-#include "backends/vulkan/vulkan.hpp"
+#include "backends/backend.hpp"
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
-#include "kernels/compile.hpp"
-#include "kernels/scene_shader.hpp"
+#include "kernels/shader_log.hpp"
 #include "scene/load.hpp"
 
 namespace flatmarch::cli {
+
+namespace {
+
+// The backends that run a GLSL shader of their own (BackendEntry::shader), in the registry's order.
+std::vector<std::string> shader_backends() {
+  std::vector<std::string> names;
+  for (const BackendEntry& e : backend_registry())
+    if (e.shader) names.push_back(e.name);
+  return names;
+}
+
+}  // namespace
 
 void add_shader(CLI::App& app) {
   auto* cmd = app.add_subcommand(
@@ -23,15 +33,19 @@ void add_shader(CLI::App& app) {
       "method or eps is a new program). --compile compiles it (or a file of yours with --file)\n"
       "and shows any error with the lines around it.");
   struct Options {
-    std::string scene, file, out, backend = "opengl", shape = "software";
+    std::string scene, file, out, backend, shape = "software";
     bool trace = false, compile = false;
   };
   auto o = std::make_shared<Options>();
+  const std::vector<std::string> backends = shader_backends();
+  if (!backends.empty()) o->backend = backends.front();
   cmd->add_option("SCENE", o->scene, kSceneArgumentHelp)->required();
   cmd->add_option("-o,--output", o->out, "Write the source here instead of to stdout");
   cmd->add_flag("--trace", o->trace, "The variant that traces one probe ray (its events)");
   cmd->add_option("--backend", o->backend,
-                  "opengl (a fragment shader) or vulkan (a compute shader)")
+                  "The backend whose shader (this build's: " +
+                      (backends.empty() ? std::string("none") : joined(backends)) +
+                      "): opengl's fragment shader, vulkan's compute shader")
       ->capture_default_str();
   cmd->add_flag("--compile", o->compile,
                 "Compile it with that backend (OSMesa's driver; glslang and the Vulkan device) and "
@@ -44,25 +58,23 @@ void add_shader(CLI::App& app) {
                   "With --compile: compile this shader (of the same stage) instead of the "
                   "generated one")
       ->check(CLI::ExistingFile);
-  cmd->callback([o] {
+  cmd->callback([o, backends] {
     const Scene scene = load_named_scene(o->scene);
     MarchParams params;
     params.method = Method::analytic;
-    if (o->backend != "opengl" && o->backend != "vulkan")
-      throw UsageError("--backend: expected opengl or vulkan, got \"" + o->backend + "\"");
-    const bool vulkan = o->backend == "vulkan";
+    if (backends.empty())
+      throw UnavailableError(
+          "shader: this flatmarch was built without a backend that runs a shader of its own "
+          "(FLATMARCH_WITH_OPENGL and FLATMARCH_WITH_VULKAN are OFF)");
+    const BackendEntry* entry = find_backend_entry(o->backend);
+    if (!entry || !entry->shader)
+      throw UsageError("--backend: expected one of " + joined(backends) + ", got \"" + o->backend +
+                       "\"");
     if (o->shape != "software" && o->shape != "gpu")
       throw UsageError("--kernel-shape: expected software or gpu, got \"" + o->shape + "\"");
-    const KernelShape shape = o->shape == "gpu" ? KernelShape::gpu : KernelShape::software;
-    // The OpenGL backend's gpu shape is a compute shader too, but for its probe-ray traces.
-    const bool compute = vulkan || (shape == KernelShape::gpu && !o->trace);
-    const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
-    const kernel::ShaderVariant variant{
-        .trace = o->trace, .shape = shape, .readback = kernel::Readback::all};
-    std::string source = compute ? kernel::scene_compute_shader(tables, variant,
-                                                                vulkan ? kernel::ComputeApi::vulkan
-                                                                       : kernel::ComputeApi::opengl)
-                                 : kernel::scene_fragment_shader(tables, variant);
+    const ShaderRequest request{
+        .trace = o->trace, .shape = o->shape == "gpu" ? KernelShape::gpu : KernelShape::software};
+    std::string source = entry->shader(scene, params, request);
     if (!o->file.empty()) {
       if (!o->compile) throw UsageError("--file: goes with --compile");
       std::ifstream in(o->file, std::ios::binary);
@@ -71,23 +83,18 @@ void add_shader(CLI::App& app) {
       source = text.str();
     }
     if (o->compile) {
-      const OpenGlBackend opengl;
-      const VulkanBackend vulkan_backend;
-      const Backend& backend = vulkan ? static_cast<const Backend&>(vulkan_backend) : opengl;
-      if (const Availability a = backend.availability(); !a.available)
+      const std::unique_ptr<Backend> backend = entry->make({});
+      if (const Availability a = backend->availability(); !a.available)
         throw UnavailableError("backend " + o->backend + " is unavailable here: " + a.reason);
+      std::string compiler;
       try {
-        if (vulkan)
-          vulkan_backend.compile(source);
-        else
-          opengl.compile(source, compute);
+        compiler = entry->compile_shader(*backend, source, request);
       } catch (const kernel::ShaderError& e) {
         throw UsageError(std::string(o->file.empty() ? "the generated shader" : o->file) + ": " +
                          e.what());
       }
       std::fprintf(stderr, "%s compiles (%s, %zu lines)\n",
-                   o->file.empty() ? "the generated shader" : o->file.c_str(),
-                   vulkan ? vulkan_backend.description().c_str() : opengl.renderer().c_str(),
+                   o->file.empty() ? "the generated shader" : o->file.c_str(), compiler.c_str(),
                    static_cast<size_t>(std::count(source.begin(), source.end(), '\n')));
       if (!o->file.empty()) return;
     }

@@ -5,11 +5,29 @@
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "scene/load.hpp"
+#ifdef FLATMARCH_WITH_VIEWER
 #include "viewer/controls.hpp"
 #include "viewer/viewer.hpp"
+#endif
 
 namespace flatmarch::cli {
 
+#ifndef FLATMARCH_WITH_VIEWER
+// A build without the OpenGL backend has no viewer (it draws with that backend's kernel).
+void add_view(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "view",
+      "Walk through a scene in a window: not in this build (built without the OpenGL "
+      "backend, whose kernel the viewer draws with: FLATMARCH_WITH_OPENGL=OFF)");
+  cmd->allow_extras();
+  cmd->callback([] {
+    throw UnavailableError(
+        "view: this flatmarch was built without the viewer (FLATMARCH_WITH_OPENGL=OFF: it draws "
+        "with the OpenGL backend's kernel); `flatmarch export-web` makes a page to walk in "
+        "instead");
+  });
+}
+#else
 void add_view(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "view",
@@ -102,5 +120,7 @@ void add_view(CLI::App& app) {
     }
   });
 }
+
+#endif  // FLATMARCH_WITH_VIEWER
 
 }  // namespace flatmarch::cli

@@ -3,18 +3,13 @@
 #include <sys/utsname.h>
 
 #include <benchmark/benchmark.h>
-#include <glslang/build_info.h>
-#include <hwy/highway.h>
-#include <oneapi/tbb/version.h>
 
 #include <fstream>
 #include <glm/detail/setup.hpp>
 #include <string>
 #include <thread>
 
-#include "backends/opengl/opengl.hpp"
-#include "backends/simd/simd.hpp"
-#include "backends/vulkan/vulkan.hpp"
+#include "backends/backend.hpp"
 #include "output/image_library.hpp"
 
 namespace flatmarch::reports {
@@ -47,32 +42,13 @@ std::string version(int major, int minor, int patch) {
 
 nlohmann::json hardware_fingerprint() {
   nlohmann::json fp;
-  const SimdBackend simd;
+  // The CPU's instruction set as the SIMD backend runs it, where the build has one (its entry's
+  // fingerprint says).
   fp["cpu"] = {{"model", cpu_model()},
                {"logical_cores", std::thread::hardware_concurrency()},
-               {"isa", simd.availability().available ? simd.isa() : "none"},
-               {"simd_lanes", simd.lanes()},
-               {"isas", simd::isa_names(true)}};
-  // The devices the GPU backends choose by default (a report run with --device says its own in
-  // each case).
-  const OpenGlBackend opengl;
-  if (const std::optional<DeviceInfo> d = opengl.device())
-    fp["opengl"] = {
-        {"renderer", opengl.renderer()}, {"device", d->name},       {"api", d->api},
-        {"driver", d->driver},           {"platform", d->platform}, {"software", d->software}};
-  else
-    fp["opengl"] = {{"unavailable", opengl.availability().reason}};
-  const VulkanBackend vulkan;
-  if (const std::optional<DeviceInfo> d = vulkan.device()) {
-    const vulkan::Device listed = vulkan.devices().at(static_cast<size_t>(vulkan.device_index()));
-    fp["vulkan"] = {{"device", d->name},
-                    {"type", d->type},
-                    {"api", listed.api},
-                    {"driver", d->driver},
-                    {"software", d->software}};
-  } else {
-    fp["vulkan"] = {{"unavailable", vulkan.availability().reason}};
-  }
+               {"isa", "none"},
+               {"simd_lanes", 0},
+               {"isas", nlohmann::json::array()}};
   utsname os{};
   if (uname(&os) == 0) {
     fp["os"] = std::string(os.sysname) + " " + os.release + " " + os.machine;
@@ -80,30 +56,50 @@ nlohmann::json hardware_fingerprint() {
   }
   fp["libraries"] = {
       {"OpenImageIO", image_library_version()},
-      {"oneTBB", version(TBB_VERSION_MAJOR, TBB_VERSION_MINOR, TBB_VERSION_PATCH)},
-      {"Highway", version(HWY_MAJOR, HWY_MINOR, HWY_PATCH)},
-      {"glslang", version(GLSLANG_VERSION_MAJOR, GLSLANG_VERSION_MINOR, GLSLANG_VERSION_PATCH)},
       {"GLM", version(GLM_VERSION_MAJOR, GLM_VERSION_MINOR, GLM_VERSION_PATCH)},
       {"nlohmann_json", version(NLOHMANN_JSON_VERSION_MAJOR, NLOHMANN_JSON_VERSION_MINOR,
                                 NLOHMANN_JSON_VERSION_PATCH)}};
   fp["build"] = {{"flatmarch", FLATMARCH_VERSION},
                  {"compiler", std::string("g++ ") + __VERSION__},
                  {"type", FLATMARCH_BUILD_TYPE}};
+  // What each backend says of the machine: its devices (the GPU backends' default ones; a report
+  // run with --device says its own in each case), instruction sets, libraries.
+  for (const BackendEntry& e : backend_registry())
+    if (e.fingerprint) e.fingerprint(fp);
   return fp;
+}
+
+std::vector<std::pair<std::string, std::string>> fingerprint_rows(const nlohmann::json& fp) {
+  const nlohmann::json cpu = fp.value("cpu", nlohmann::json::object());
+  const auto text = [](const nlohmann::json& v) {
+    return v.is_string() ? v.get<std::string>() : v.dump();
+  };
+  std::vector<std::pair<std::string, std::string>> rows{
+      {"CPU", text(cpu.value("model", nlohmann::json("?"))) + ", " +
+                  text(cpu.value("logical_cores", nlohmann::json("?"))) + " threads"}};
+  for (const BackendEntry& e : backend_registry())
+    if (e.fingerprint_rows)
+      for (auto& row : e.fingerprint_rows(fp)) rows.push_back(std::move(row));
+  rows.emplace_back("OS", fp.value("os", "?") + " on " + fp.value("host", "?"));
+  std::string libraries;
+  const nlohmann::json listed = fp.value("libraries", nlohmann::json::object());
+  for (const auto& [name, v] : listed.items())  // items() refers to it, not a copy
+    libraries += (libraries.empty() ? "" : ", ") + name + " " + text(v);
+  rows.emplace_back("Libraries", libraries);
+  const nlohmann::json b = fp.value("build", nlohmann::json::object());
+  rows.emplace_back("Build", "flatmarch " + text(b.value("flatmarch", nlohmann::json("None"))) +
+                                 ", " + text(b.value("compiler", nlohmann::json("None"))) + ", " +
+                                 text(b.value("type", nlohmann::json("None"))));
+  return rows;
 }
 
 std::string describe_machine(const nlohmann::json& fp) {
   std::string s = fp["cpu"]["model"].get<std::string>() + ", " +
                   std::to_string(fp["cpu"]["logical_cores"].get<int>()) + " threads, " +
-                  fp["cpu"]["isa"].get<std::string>();
-  // Results written before devices carried the software flag have none.
-  const auto software = [](const nlohmann::json& d) {
-    return d.value("software", false) ? " (software)" : "";
-  };
-  if (fp["vulkan"].contains("device"))
-    s += "; Vulkan: " + fp["vulkan"]["device"].get<std::string>() + software(fp["vulkan"]);
-  if (fp["opengl"].contains("renderer"))
-    s += "; OpenGL: " + fp["opengl"]["renderer"].get<std::string>() + software(fp["opengl"]);
+                  fp["cpu"].value("isa", "none");
+  for (const BackendEntry& e : backend_registry())
+    if (e.describe_machine)
+      if (const std::string part = e.describe_machine(fp); !part.empty()) s += "; " + part;
   return s;
 }
 

@@ -4,12 +4,21 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace flatmarch::reports {
 
 nlohmann::json hardware_fingerprint();
 
-// One line: CPU model, cores, ISA; the Vulkan device; OpenGL's renderer.
+// The report page's machine table, a label and a text a row: the CPU, what each backend says
+// (BackendEntry::fingerprint_rows), the OS, the libraries and the build.
+std::vector<std::pair<std::string, std::string>> fingerprint_rows(
+    const nlohmann::json& fingerprint);
+
+// One line: CPU model, cores, ISA; then what each backend says (OpenGL's renderer, the Vulkan
+// device: BackendEntry::describe_machine).
 std::string describe_machine(const nlohmann::json& fingerprint);
 
 // Adds the fingerprint's fields to Google Benchmark's context ("fingerprint.cpu.model", ...), so

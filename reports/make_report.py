@@ -212,25 +212,17 @@ def device_text(backend):
     return d["name"] + (" (software)" if d.get("software") else "") + (f', {d["driver"]}' if d.get("driver") else "")
 
 
-def fingerprint_rows(fp):
+def fingerprint_rows(results):
+    """The machine table's rows, as the run wrote them (its registry's fingerprint_rows: the CPU,
+    what each backend says of the machine, the OS, the libraries, the build); a run written
+    before they were has its CPU and OS alone."""
+    rows = results.get("registry", {}).get("fingerprint_rows")
+    if rows is not None:
+        return [tuple(r) for r in rows]
+    fp = results.get("fingerprint", {})
     cpu = fp.get("cpu", {})
-    rows = [
-        ("CPU", f'{cpu.get("model", "?")}, {cpu.get("logical_cores", "?")} threads'),
-        ("SIMD", f'{cpu.get("isa", "?")} ({cpu.get("simd_lanes", "?")} lanes); compiled in: {", ".join(cpu.get("isas", []))}'),
-    ]
-    gl = fp.get("opengl", {})
-    rows.append(("OpenGL", (f'{gl["renderer"]}' + (f' through {gl["platform"]}' if "platform" in gl else "") +
-                            (", software: a rasteriser on the CPU" if gl.get("software") else ""))
-                 if "renderer" in gl else "unavailable: " + gl.get("unavailable", "?")))
-    vk = fp.get("vulkan", {})
-    rows.append(("Vulkan", f'{vk["device"]} ({vk.get("type")}, Vulkan {vk.get("api")}, driver {vk.get("driver")}'
-                 + (", software: a rasteriser on the CPU" if vk.get("software") else "") + ")"
-                 if "device" in vk else "unavailable: " + vk.get("unavailable", "?")))
-    rows.append(("OS", f'{fp.get("os", "?")} on {fp.get("host", "?")}'))
-    rows.append(("Libraries", ", ".join(f"{k} {v}" for k, v in fp.get("libraries", {}).items())))
-    b = fp.get("build", {})
-    rows.append(("Build", f'flatmarch {b.get("flatmarch")}, {b.get("compiler")}, {b.get("type")}'))
-    return rows
+    return [("CPU", f'{cpu.get("model", "?")}, {cpu.get("logical_cores", "?")} threads'),
+            ("OS", f'{fp.get("os", "?")} on {fp.get("host", "?")}')]
 
 
 # --- One machine.
@@ -1128,7 +1120,7 @@ def one_machine(results, images, previous=None, previous_path=""):
 
 
 def machine_section(results):
-    return "<h2 id=machine>Machine</h2>" + table(["", ""], fingerprint_rows(results["fingerprint"]))
+    return "<h2 id=machine>Machine</h2>" + table(["", ""], fingerprint_rows(results))
 
 
 def shards_note(results):
@@ -1150,21 +1142,21 @@ def shards_note(results):
 
 
 def gpu_text(fp):
-    """The machine's GPU, as its GPU backends found one: ", GPU NAME", or "" without one."""
-    for api in ("vulkan", "opengl"):
-        d = fp.get(api, {})
+    """The machine's GPU, as its GPU backends found one (a device of theirs in the fingerprint
+    that is not software): ", GPU NAME", or "" without one."""
+    for d in fp.values():
+        if not isinstance(d, dict):
+            continue
         name = d.get("device") or d.get("renderer")
-        if name and "software" in d and not d["software"]:
+        if isinstance(name, str) and "software" in d and not d["software"]:
             return f", GPU {name}"
     return ""
 
 
 def machines(all_results, names):
     body = ["<h1>flatmarch: machines compared</h1>"]
-    fps = [r["fingerprint"] for r in all_results]
-    rows = []
-    for k, (label, _) in enumerate(fingerprint_rows(fps[0])):
-        rows.append([label] + [fingerprint_rows(fp)[k][1] for fp in fps])
+    each = [dict(fingerprint_rows(r)) for r in all_results]
+    rows = [[label] + [e.get(label, "") for e in each] for label, _ in fingerprint_rows(all_results[0])]
     body.append(table(["", *names], rows))
     backends = sorted({b["backend"] for r in all_results for b in r.get("ranking", [])})
     fig, ax = plt.subplots(figsize=(2 + 1.6 * len(backends), 4.5))

@@ -11,7 +11,6 @@
 #include <regex>
 #include <sstream>
 
-#include "backends/simd/simd.hpp"
 #include "output/image_io.hpp"
 #include "reports/shard.hpp"
 #include "reports/surfaces.hpp"
@@ -122,60 +121,35 @@ class CollectingReporter : public benchmark::JSONReporter {
   std::function<void(const std::string&)> on_run_;
 };
 
-// The SIMD backend's rays a second on one thread, its instruction set the same: the median of
-// three frames of the colour after one untimed (the lane efficiency's numerator, against the
-// scalar backend's one thread). 0 where the backend runs one thread already (its timed frames
-// are that figure) or cannot run.
-double one_thread_rays_per_s(const SimdBackend& simd, const Scene& scene, const Camera& camera,
-                             int width, int height, const MarchParams& params) {
-  if (simd.threads() == 1 || simd.isa().empty()) return 0.0;
-  BackendOptions options;
-  options.isa = simd.isa();
-  options.threads = 1;
-  const SimdBackend one(options);
-  one.render_colour(scene, camera, width, height, params, {});
-  std::array<double, 3> seconds{};
-  for (double& s : seconds) {
-    const auto start = std::chrono::steady_clock::now();
-    const Frame f = one.render_colour(scene, camera, width, height, params, {});
-    benchmark::DoNotOptimize(f.rgb.data());
-    s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  }
-  std::sort(seconds.begin(), seconds.end());
-  return seconds[1] > 0.0 ? static_cast<double>(width) * height / seconds[1] : 0.0;
-}
-
 }  // namespace
 
 void register_frame_benchmark(const Backend& backend, const Scene& scene, const Camera& camera,
                               const MarchParams& params, int width, int height, int repetitions,
                               double min_time, Frame* last, const std::string& name) {
-  const auto* simd = dynamic_cast<const SimdBackend*>(&backend);
   const std::optional<DeviceInfo> device = backend.device();
   const std::string label = device ? device_label(*device) : "";
   // The case's whole frame, drawn once before the first repetition's timed frames.
   auto whole = std::make_shared<std::optional<Frame>>();
-  // The SIMD backend's lane counts and peak, the same in every repetition of a case (its frames
-  // are deterministic): measured in the first, the peak over five times --min-time, within 0.01
-  // to 0.1 s (the report's default 0.02 s: 0.1 s; the regression gate's 0.01 s: 0.05 s, about
-  // 4 s less over its 75 SIMD cases), and over 0.1 s where min_time is 0 (Google Benchmark's
-  // own, 0.5 s unless its flag says otherwise: backend_bench). Each repetition's took a counted
-  // frame and 0.05 s of stepping: the regression gate 133 s -> 118 s measured once instead.
+  // A backend's lane figures (the SIMD backend's lane counts and peak), the same in every
+  // repetition of a case (its frames are deterministic): measured in the first, the peak over
+  // five times --min-time, within 0.01 to 0.1 s (the report's default 0.02 s: 0.1 s; the
+  // regression gate's 0.01 s: 0.05 s, about 4 s less over its 75 SIMD cases), and over 0.1 s
+  // where min_time is 0 (Google Benchmark's own, 0.5 s unless its flag says otherwise:
+  // backend_bench). Each repetition's took a counted frame and 0.05 s of stepping: the
+  // regression gate 133 s -> 118 s measured once instead.
   const double peak_seconds = min_time > 0.0 ? std::clamp(5.0 * min_time, 0.01, 0.1) : 0.1;
-  struct SimdFigures {
+  struct Lanes {
     bool known = false;
-    simd::LaneCounts lanes;
-    double peak = 0.0;
-    double one_thread_rays_per_s = 0.0;  // 0: not measured (the backend runs one thread)
+    std::optional<LaneFigures> figures;
   };
-  auto simd_figures = std::make_shared<SimdFigures>();
+  auto lanes = std::make_shared<Lanes>();
   benchmark::internal::Benchmark* b =
       benchmark::RegisterBenchmark(
           (name.empty() ? case_name(backend.name(), params.method, scene.name, width, height)
                         : name)
               .c_str(),
-          [&backend, &scene, camera, params, width, height, last, simd, whole, simd_figures,
-           peak_seconds, label](benchmark::State& state) {
+          [&backend, &scene, camera, params, width, height, last, whole, lanes, peak_seconds,
+           label](benchmark::State& state) {
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
             DeviceTimes device_times;
             try {
@@ -198,19 +172,16 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                 state.SetIterationTime(seconds);
                 device_times.add(backend, seconds);
               }
-              if (simd && !simd_figures->known) {
-                simd->render_counted(scene, camera, width, height, params, {}, simd_figures->lanes);
-                simd_figures->peak =
-                    simd->peak_lane_steps(scene, camera, width, height, params, peak_seconds);
-                simd_figures->one_thread_rays_per_s =
-                    one_thread_rays_per_s(*simd, scene, camera, width, height, params);
-                simd_figures->known = true;
+              if (!lanes->known) {
+                lanes->figures =
+                    backend.lane_figures(scene, camera, width, height, params, peak_seconds);
+                lanes->known = true;
               }
-              if (simd) {
-                simd_counters(state, **whole, simd_figures->lanes, simd_figures->peak);
-                state.counters["lanes"] = simd->lanes();
-                if (simd_figures->one_thread_rays_per_s > 0.0)
-                  state.counters["one_thread_rays_per_s"] = simd_figures->one_thread_rays_per_s;
+              if (lanes->figures) {
+                lane_counters(state, **whole, *lanes->figures);
+                state.counters["lanes"] = lanes->figures->lanes;
+                if (lanes->figures->one_thread_rays_per_s > 0.0)
+                  state.counters["one_thread_rays_per_s"] = lanes->figures->one_thread_rays_per_s;
               }
             } catch (const std::exception& e) {
               state.SkipWithError(e.what());
@@ -244,13 +215,13 @@ void frame_counters(benchmark::State& state, const Frame& frame) {
       pixels;
 }
 
-void simd_counters(benchmark::State& state, const Frame& frame, const simd::LaneCounts& lanes,
-                   double peak) {
+void lane_counters(benchmark::State& state, const Frame& frame, const LaneFigures& lanes) {
   state.counters["lane_utilisation"] =
       static_cast<double>(lanes.active) / static_cast<double>(lanes.slots);
   const double steps = std::accumulate(frame.steps.begin(), frame.steps.end(), 0.0);
   state.counters["steps_per_s"] =
       benchmark::Counter(steps, benchmark::Counter::kIsIterationInvariantRate);
+  const double peak = lanes.peak_steps_per_s;
   if (peak <= 0.0) return;  // no step to time (SimdBackend::peak_lane_steps)
   state.counters["peak_steps_per_s"] = peak;
   state.counters["of_peak"] =

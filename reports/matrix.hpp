@@ -14,7 +14,6 @@
 #include <benchmark/benchmark.h>
 
 #include "backends/backend.hpp"
-#include "backends/simd/simd.hpp"
 #include "conformance/suite.hpp"
 
 namespace flatmarch::reports {
@@ -126,7 +125,7 @@ nlohmann::json run_registered_benchmarks(const std::function<void(const std::str
 // timed by the backend's own measure where it has one (Backend::last_frame_seconds: webgl's page),
 // else by the clock around it (Google Benchmark's manual time); counters rays_per_s, steps_mean,
 // steps_p99, crossings_mean, out_of_steps, a GPU backend's device times (DeviceTimes) and, for the
-// SIMD backend, lane_utilisation, steps_per_s, peak_steps_per_s and of_peak (simd_counters), lanes,
+// SIMD backend, lane_utilisation, steps_per_s, peak_steps_per_s and of_peak (lane_counters), lanes,
 // and one_thread_rays_per_s (the median of three frames on one thread of its instruction set,
 // where it runs more: the numerator of its lane efficiency, report.hpp); a GPU backend's runs are
 // labelled with its device (device_label). `last`, when given, receives the
@@ -159,14 +158,13 @@ class DeviceTimes {
 // reached max_steps).
 void frame_counters(benchmark::State& state, const Frame& frame);
 
-// The SIMD backend's counters of a timed frame: lane_utilisation (active lanes over lanes, of
-// `lanes`), steps_per_s (the frame's steps, summed over its rays, a second: a rate over the
-// iterations), peak_steps_per_s (`peak`, the case's SimdBackend::peak_lane_steps: one room's step
-// on full packets on all its threads; none where it is 0, no step to time) and of_peak, the share
-// of that peak the frame's steps reach: how close to what this CPU can do the backend runs (idle
-// lanes, shading, pixel writes and scheduling make the rest).
-void simd_counters(benchmark::State& state, const Frame& frame, const simd::LaneCounts& lanes,
-                   double peak);
+// A lane backend's counters of a timed frame (LaneFigures, the SIMD backend's): lane_utilisation
+// (active lanes over lanes), steps_per_s (the frame's steps, summed over its rays, a second: a
+// rate over the iterations), peak_steps_per_s (the case's peak: one room's step on full packets
+// on all its threads; none where it is 0, no step to time) and of_peak, the share of that peak
+// the frame's steps reach: how close to what this CPU can do the backend runs (idle lanes,
+// shading, pixel writes and scheduling make the rest).
+void lane_counters(benchmark::State& state, const Frame& frame, const LaneFigures& lanes);
 
 // The name register_frame_benchmark gives.
 std::string case_name(const std::string& backend, Method method, const std::string& scene,

@@ -89,9 +89,13 @@ json report_header(const std::vector<Scene>& scenes, const ReportOptions& o) {
   // The lists make_report.py draws by (it restates none).
   json methods = json::array();
   for (Method m : kKernelMethods) methods.push_back(to_string(m));
+  json machine = json::array();  // the page's machine table, as the backends describe it
+  for (const auto& [label, text] : fingerprint_rows(results["fingerprint"]))
+    machine.push_back({label, text});
   results["registry"] = {{"backends", kernel_backend_names()},
                          {"methods", methods},
-                         {"surface_types", surface_types()}};
+                         {"surface_types", surface_types()},
+                         {"fingerprint_rows", machine}};
   results["options"] = {
       {"size", std::to_string(o.matrix.width) + "x" + std::to_string(o.matrix.height)},
       {"conform_size",

@@ -1,4 +1,5 @@
 #include "reports/shard.hpp"
+#include "backends/backend.hpp"
 #include "reports/surfaces.hpp"
 
 #include <algorithm>
@@ -41,24 +42,30 @@ std::vector<int> assign_shards(const std::vector<double>& costs, int count) {
   return shard;
 }
 
+namespace {
+
+// The registry's cost of a backend (BackendEntry::cost); the default one for a backend it does
+// not know (a test's, by the cost of the cheapest).
+BackendCost cost_of(const std::string& backend) {
+  const BackendEntry* entry = find_backend_entry(backend);
+  return entry ? entry->cost : BackendCost{};
+}
+
+}  // namespace
+
 double frame_cost(const std::string& backend, const std::string& method, int width, int height) {
   // Seconds a case took on this 2-core machine at 160x90 (conform's per-case seconds over the
-  // gallery, 2026-11-26); a browser's page costs half a second more to open and compile.
+  // gallery, 2026-11-26): the backend's BackendCost::frame_seconds, a tenth of it analytic.
   const double frame = static_cast<double>(width) * static_cast<double>(height) / 14400.0;
   const double marching = method == "analytic" ? 0.1 : 1.0;
-  if (backend == "webgl") return 0.2 * marching * frame;
-  if (backend == "vulkan") return 0.02 * marching * frame;
-  if (backend == "scalar") return 0.07 * marching * frame;
-  if (backend == "opengl") return 0.02 * marching * frame;
-  return 0.01 * marching * frame;  // simd, and backends not measured yet
+  return cost_of(backend).frame_seconds * marching * frame;
 }
 
 double timed_case_cost(const std::string& backend, double frame_seconds, int repetitions,
                        double min_time) {
   double seconds = 2.0 * frame_seconds + repetitions * std::max(1.6 * min_time, frame_seconds);
-  // One thread of this 2-core machine's two takes twice a frame's time.
-  if (backend == "simd")
-    seconds += frame_seconds + std::clamp(5.0 * min_time, 0.01, 0.1) + 4.0 * 2.0 * frame_seconds;
+  if (const BackendCost cost = cost_of(backend); cost.extra_timed_seconds)
+    seconds += cost.extra_timed_seconds(frame_seconds, min_time);
   return seconds;
 }
 
@@ -78,8 +85,7 @@ double conformance_case_cost(const std::string& backend, const std::string& meth
   // backend's frames; a browser's page costs half a second more to open and compile.
   const double frame = static_cast<double>(width) * static_cast<double>(height) / 14400.0;
   const double truth = 0.1 * frame * (1.0 + 0.02 * edges);
-  const double startup = backend == "webgl" ? 0.5 : backend == "vulkan" ? 0.08 : 0.0;
-  return truth + startup + frame_cost(backend, method, width, height);
+  return truth + cost_of(backend).startup_seconds + frame_cost(backend, method, width, height);
 }
 
 json shard_record(const Shard& shard, const std::vector<std::string>& cases,

@@ -407,6 +407,9 @@ std::vector<ArgCase> shared_option_cases() {
   for (const auto& [command, args] : commands)
     for (const auto& [name, option, fragment] : options) {
       if (command == "view" && option[0] != "--max-steps") continue;  // no backend options
+#ifndef FLATMARCH_WITH_VIEWER
+      if (command == "view") continue;  // a build without the viewer: `view` says so, exit 3
+#endif
       std::vector<std::string> all = args;
       all.insert(all.end(), option.begin(), option.end());
       cases.push_back({command + "_" + name, all, fragment});

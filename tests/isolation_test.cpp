@@ -61,22 +61,12 @@ test::ProcessResult conform(const std::string& json_path, const std::vector<std:
     setenv("FLATMARCH_FAULTY", faults, 1);
   else
     unsetenv("FLATMARCH_FAULTY");
-  std::vector<std::string> argv{self(),
-                                kCliFlag,
-                                "conform",
-                                "--backend",
-                                "faulty",
-                                "--backend",
-                                "scalar",
-                                "--size",
-                                "32x18",
-                                "--json",
-                                json_path,
-                                "--deadline-floor",
-                                "3",
-                                "--worker-memory",
-                                "2",
-                                "--gallery",
+  std::vector<std::string> argv{self(), kCliFlag, "conform", "--backend", "faulty", "--backend",
+                                "scalar", "--size", "32x18", "--json", json_path,
+                                // The hang's wait; long enough for the oom case to fill
+                                // its 2 GiB under a loaded 2-core machine's other tests (3 s
+                                // was not, once, in a -O1 build).
+                                "--deadline-floor", "6", "--worker-memory", "2", "--gallery",
                                 FLATMARCH_SOURCE_DIR "/scenes"};
   for (const char* scene : {"torus", "l_shape", "cube", "klein_bottle", "mirror_square"})
     argv.insert(argv.end(), {"--scene", scene});

@@ -228,6 +228,35 @@ Frame SimdBackend::render_counted(const Scene& scene, const Camera& camera, int 
   return frame;
 }
 
+std::optional<LaneFigures> SimdBackend::lane_figures(const Scene& scene, const Camera& camera,
+                                                     int width, int height,
+                                                     const MarchParams& params,
+                                                     double peak_seconds) const {
+  LaneFigures f;
+  f.lanes = lanes();
+  simd::LaneCounts counts;
+  render_counted(scene, camera, width, height, params, {}, counts);
+  f.active = counts.active;
+  f.slots = counts.slots;
+  f.peak_steps_per_s = peak_lane_steps(scene, camera, width, height, params, peak_seconds);
+  if (threads() == 1 || isa().empty()) return f;
+  BackendOptions options;
+  options.isa = isa();
+  options.threads = 1;
+  const SimdBackend one(options);
+  one.render_colour(scene, camera, width, height, params, {});
+  std::array<double, 3> seconds{};
+  for (double& s : seconds) {
+    const auto start = std::chrono::steady_clock::now();
+    const Frame frame = one.render_colour(scene, camera, width, height, params, {});
+    s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (frame.rgb.empty() && frame.srgb.empty()) throw std::logic_error("an empty frame");
+  }
+  std::sort(seconds.begin(), seconds.end());
+  if (seconds[1] > 0.0) f.one_thread_rays_per_s = static_cast<double>(width) * height / seconds[1];
+  return f;
+}
+
 double SimdBackend::peak_lane_steps(const Scene& scene, const Camera& camera, int width, int height,
                                     const MarchParams& params, double seconds) const {
   check_precision(params);

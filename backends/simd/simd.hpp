@@ -51,6 +51,9 @@ class SimdBackend final : public Backend {
   // when the rays of the packet timed (the frame's central tile) all end as they start.
   double peak_lane_steps(const Scene& scene, const Camera& camera, int width, int height,
                          const MarchParams& params, double seconds = 0.05) const;
+  std::optional<LaneFigures> lane_figures(const Scene& scene, const Camera& camera, int width,
+                                          int height, const MarchParams& params,
+                                          double peak_seconds) const override;
   // The instruction set it runs (--isa's name) and its lanes per packet; "" and 0 if unavailable.
   std::string isa() const { return isa_; }
   int lanes() const;
