@@ -1,7 +1,7 @@
 // The SIMD backend at 640x360 from each scene's own camera: rays per second and lane utilisation
 // (active lanes over lanes, summed over every pass of every packet step), per gallery scene and
 // method, on all cores with the best instruction set here, and on staircases of 4, 32 and 128
-// squares (reports/surfaces.hpp; rays run to max_distance 40), where rays spread over many rooms,
+// squares (scene/surfaces.hpp; rays run to max_distance 40), where rays spread over many rooms,
 // and of 32 and 128 squares drawn apart (staircase_apart_N: rooms that differ in coordinates).
 // For the L-shape, the double pentagon, the cube and the 32-square staircase it also runs, side by
 // side in one run, the scalar backend and every instruction set on one thread and on all cores:
@@ -28,7 +28,7 @@
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/simd.hpp"
 #include "bench/gallery.hpp"
-#include "reports/surfaces.hpp"
+#include "scene/surfaces.hpp"
 
 namespace flatmarch {
 namespace {
@@ -86,11 +86,11 @@ int main(int argc, char** argv) {
 
   std::vector<std::unique_ptr<Scene>> scenes = bench::load_gallery();
   for (int squares : {4, 32, 128})  // named staircase_N
-    scenes.push_back(std::make_unique<Scene>(reports::staircase_surface(squares)));
+    scenes.push_back(std::make_unique<Scene>(staircase_surface(squares)));
   // The same surface with its squares drawn apart (rooms that differ in their coordinates):
   // staircase_apart_N.
   for (int squares : {32, 128})
-    scenes.push_back(std::make_unique<Scene>(reports::staircase_surface(squares, true)));
+    scenes.push_back(std::make_unique<Scene>(staircase_surface(squares, true)));
   const std::vector<std::string> isas = simd::isa_names(true);
   const int cores = tbb::info::default_concurrency();
   std::cerr << "simd_bench: " << cores << " cores; instruction sets here:";

@@ -1,6 +1,6 @@
 #include "cli/common.hpp"
 
-#include "backends/dynamic_library.hpp"
+#include "output/dynamic_library.hpp"
 
 #include <sys/resource.h>
 #include <unistd.h>

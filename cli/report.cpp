@@ -9,17 +9,17 @@
 #include <optional>
 #include <thread>
 
-#include "backends/dynamic_library.hpp"
 #include "cli/case_progress.hpp"
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "cli/supervised.hpp"
 #include "conformance/suite.hpp"
+#include "output/dynamic_library.hpp"
 #include "reports/fingerprint.hpp"
 #include "reports/report.hpp"
 #include "reports/supervise.hpp"
-#include "reports/surfaces.hpp"
 #include "scene/load.hpp"
+#include "scene/surfaces.hpp"
 
 namespace flatmarch::cli {
 

@@ -6,8 +6,8 @@
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "reports/report.hpp"
-#include "reports/surfaces.hpp"
 #include "scene/load.hpp"
+#include "scene/surfaces.hpp"
 
 namespace flatmarch::cli {
 
@@ -35,7 +35,7 @@ void add_select(CLI::App& app) {
     const json results = read_json("RESULTS", o->results);
     if (!results.contains("recommendation") || !results.contains("fingerprint"))
       throw UsageError("RESULTS: " + o->results + " is not a results file of `flatmarch report`");
-    const std::string type = o->scene.empty() ? "" : reports::surface_type(load_scene(o->scene));
+    const std::string type = o->scene.empty() ? "" : surface_type(load_scene(o->scene));
     std::printf("%s", reports::describe_selection(results, type).c_str());
   });
 }

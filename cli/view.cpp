@@ -88,9 +88,9 @@ void add_view(CLI::App& app) {
     o->params.method = *method;
     check_march_params(o->params);
     // The keys step eps and offset within these bounds, so the viewer starts within them.
-    if (!(o->params.eps >= viewer::kMinEps && o->params.eps <= viewer::kMaxEps))
+    if (!(o->params.eps >= motion::kMinEps && o->params.eps <= motion::kMaxEps))
       throw UsageError("--eps: must lie in [1e-7, 1e-2]");
-    if (!(o->params.offset > o->params.eps && o->params.offset <= viewer::kMaxOffset))
+    if (!(o->params.offset > o->params.eps && o->params.offset <= motion::kMaxOffset))
       throw UsageError(
           "--offset: must lie above --eps (a ray placed no further than eps from the edge it "
           "came through crosses back) and at most 0.5");

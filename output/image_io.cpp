@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "backends/dynamic_library.hpp"
+#include "output/dynamic_library.hpp"
 #include "output/image_library.hpp"
 
 namespace flatmarch {

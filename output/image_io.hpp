@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "backends/backend.hpp"
+#include "output/frame.hpp"
 
 namespace flatmarch {
 

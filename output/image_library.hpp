@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "backends/backend.hpp"
+#include "output/frame.hpp"
 
 namespace flatmarch {
 

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "backends/backend.hpp"
+#include "output/trace.hpp"
 
 namespace flatmarch {
 

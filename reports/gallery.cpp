@@ -8,7 +8,7 @@
 #include "conformance/ambiguity.hpp"
 #include "conformance/compare.hpp"
 #include "output/image_io.hpp"
-#include "reports/surfaces.hpp"
+#include "scene/surfaces.hpp"
 
 namespace flatmarch::reports {
 

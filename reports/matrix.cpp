@@ -13,7 +13,7 @@
 
 #include "output/image_io.hpp"
 #include "reports/shard.hpp"
-#include "reports/surfaces.hpp"
+#include "scene/surfaces.hpp"
 
 namespace flatmarch::reports {
 

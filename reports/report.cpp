@@ -13,7 +13,7 @@
 #include "reports/gallery.hpp"
 #include "reports/shard.hpp"
 #include "reports/supervise.hpp"
-#include "reports/surfaces.hpp"
+#include "scene/surfaces.hpp"
 
 namespace flatmarch::reports {
 

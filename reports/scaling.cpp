@@ -7,7 +7,7 @@
 
 #include "reports/matrix.hpp"
 #include "reports/shard.hpp"
-#include "reports/surfaces.hpp"
+#include "scene/surfaces.hpp"
 
 namespace flatmarch::reports {
 

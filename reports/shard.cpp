@@ -1,6 +1,6 @@
 #include "reports/shard.hpp"
 #include "backends/backend.hpp"
-#include "reports/surfaces.hpp"
+#include "scene/surfaces.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -19,8 +19,8 @@
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/packet.hpp"
 #include "backends/simd/simd.hpp"
-#include "reports/surfaces.hpp"
 #include "scene/load.hpp"
+#include "scene/surfaces.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
 
@@ -158,7 +158,7 @@ TEST(Simd, EveryInstructionSetAgreesWithScalar) {
 TEST(Simd, RaysSpreadOverManyRoomsAgreeWithScalar) {
   for (const auto& [squares, apart] : std::vector<std::pair<int, bool>>{
            {32, false}, {128, false}, {130, false}, {32, true}, {128, true}, {130, true}}) {
-    const Scene scene = reports::staircase_surface(squares, apart);
+    const Scene scene = staircase_surface(squares, apart);
     for (Method m : {Method::sphere, Method::analytic}) {
       MarchParams params;
       params.method = m;
@@ -260,9 +260,9 @@ TEST(Simd, ExitByTheNearestLineAgreesWithScalar) {
   };
   EXPECT_TRUE(taken(test::gallery_scene("cube"), analytic));
   EXPECT_TRUE(taken(test::gallery_scene("double_pentagon"), analytic));
-  EXPECT_FALSE(taken(test::gallery_scene("l_shape"), analytic));        // one room
-  EXPECT_FALSE(taken(hexagon_and_square(), analytic));                  // not convex
-  EXPECT_FALSE(taken(reports::staircase_surface(8, false), analytic));  // rooms alike
+  EXPECT_FALSE(taken(test::gallery_scene("l_shape"), analytic));  // one room
+  EXPECT_FALSE(taken(hexagon_and_square(), analytic));            // not convex
+  EXPECT_FALSE(taken(staircase_surface(8, false), analytic));     // rooms alike
   MarchParams sphere;
   sphere.method = Method::sphere;
   EXPECT_FALSE(taken(test::gallery_scene("cube"), sphere));
@@ -288,7 +288,7 @@ TEST(Simd, TracesMatchScalar) {
   // gluings by slot (EdgeTables::glue_by_slot) on AVX-512 and AVX2.
   std::vector<std::string> names = test::gallery_names();
   names.emplace_back("staircase_32");
-  const Scene staircase = reports::staircase_surface(32, false);
+  const Scene staircase = staircase_surface(32, false);
   for (const std::string& name : names) {
     const Scene& scene = name == "staircase_32" ? staircase : test::gallery_scene(name);
     const Camera& c = scene.camera;
@@ -356,7 +356,7 @@ TEST(Simd, RoomStepsStepEveryLaneOfTheCentralPacket) {
 // normal. Edge 1 of square k is glued to square k + 1 (k even), edge 2 to the square above.
 TEST(Simd, EdgeTablesFindTheNumbersAlikeInEveryRoom) {
   for (const bool apart : {false, true}) {
-    const Scene scene = reports::staircase_surface(8, apart);
+    const Scene scene = staircase_surface(8, apart);
     const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
     const simd::EdgeTables t = simd::packet_job(tables).edges;
     SCOPED_TRACE(scene.name);

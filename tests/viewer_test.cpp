@@ -38,7 +38,7 @@ constexpr int kWidth = 320, kHeight = 180;
 // and both scenes' largest vertex coordinate is 4.
 constexpr double kSpeed = 2.0;
 // Walking crosses a gluing with the point placed 1e-9 scene.scale inside the edge
-// (viewer/walk.cpp), so positions agree to well within this.
+// (motion/walk.cpp), so positions agree to well within this.
 constexpr double kPositionTolerance = 1e-6;
 
 bool on_path(const std::string& program) {
@@ -297,9 +297,9 @@ TEST_F(ViewerTest, BadSceneAndArgumentsExit2) {
 
 TEST(ViewerControls, OffsetStaysAboveEps) {
   MarchParams start;  // eps 1e-4, offset 2e-4
-  viewer::MarchSettings s(start);
+  motion::MarchSettings s(start);
   EXPECT_TRUE(s.step_offset(-1));  // 1.12e-4: still above eps
-  s = viewer::MarchSettings(start);
+  s = motion::MarchSettings(start);
   EXPECT_TRUE(s.step_eps(2));  // eps 3.16e-4 passes offset 2e-4, which follows to 3.56e-4
   EXPECT_NEAR(s.params().eps, 1e-4 * std::sqrt(10.0), 1e-18);
   EXPECT_GT(s.params().offset, s.params().eps);
@@ -310,19 +310,19 @@ TEST(ViewerControls, OffsetStaysAboveEps) {
   EXPECT_EQ(s.params().eps, start.eps);
   EXPECT_EQ(s.params().offset, start.offset);
   for (int k = 0; k < 100; ++k) s.step_eps(1);  // stops at the bound
-  EXPECT_LE(s.params().eps, viewer::kMaxEps);
+  EXPECT_LE(s.params().eps, motion::kMaxEps);
   EXPECT_GT(s.params().offset, s.params().eps);
 }
 
 TEST(ViewerControls, RenderScaleStepsWithinItsBounds) {
-  viewer::RenderScale scale(0.5);
+  motion::RenderScale scale(0.5);
   EXPECT_TRUE(scale.step(2));
   EXPECT_EQ(scale.value(), 1.0);
   EXPECT_FALSE(scale.step(1));
   EXPECT_TRUE(scale.step(-2));
   EXPECT_EQ(scale.value(), 0.5);
   for (int k = 0; k < 100; ++k) scale.step(-1);
-  EXPECT_EQ(scale.value(), viewer::kMinScale);
+  EXPECT_EQ(scale.value(), motion::kMinScale);
 }
 
 TEST(ViewerScript, ParsesEveryCommand) {

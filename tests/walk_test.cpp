@@ -15,12 +15,12 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/webgl/chromium.hpp"
+#include "motion/walk.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
-#include "viewer/walk.hpp"
 
-namespace flatmarch::viewer {
+namespace flatmarch::motion {
 namespace {
 
 // A crossing places the point kPush * scene.scale (at most 6e-9 here) inside the edge it came in
@@ -362,4 +362,4 @@ TEST(WebWalk, ThePageWalksAsTheViewerDoes) {
 }
 
 }  // namespace
-}  // namespace flatmarch::viewer
+}  // namespace flatmarch::motion

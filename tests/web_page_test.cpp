@@ -1,6 +1,6 @@
 // The exported page's controls as a visitor uses them (issue 23), driven through the DevTools
 // protocol in headless Chromium: touch (one finger drags to look, two drag to move), the mouse,
-// the wheel, the eps and offset keys (stepped as the viewer steps them, viewer/controls.hpp) and
+// the wheel, the eps and offset keys (stepped as the viewer steps them, motion/settings.hpp) and
 // the floor-plan inset. Skipped, with the reason, where there is no Chromium.
 #include <gtest/gtest.h>
 
@@ -16,11 +16,11 @@
 #include "backends/webgl/chromium.hpp"
 #include "backends/webgl/webgl.hpp"
 #include "cli/common.hpp"
+#include "motion/settings.hpp"
+#include "motion/walk.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
-#include "viewer/controls.hpp"
-#include "viewer/walk.hpp"
 #include "web/page.hpp"
 
 namespace flatmarch {
@@ -94,7 +94,7 @@ TEST_F(WebPage, OneFingerDragsToLookAndTwoDragToMove) {
   touch("touchEnd", json::array());
   const json turned = state();
   EXPECT_NEAR(turned["camera"]["yaw_deg"].get<double>(),
-              before["camera"]["yaw_deg"].get<double>() + 2 * viewer::kDegreesPerPixel * 50, 1e-9);
+              before["camera"]["yaw_deg"].get<double>() + 2 * motion::kDegreesPerPixel * 50, 1e-9);
   EXPECT_EQ(turned["camera"]["position"], before["camera"]["position"]);
 
   // Two fingers 40 pixels up the screen: forward by 40 / 200 of the scene's scale, as walk()
@@ -106,8 +106,8 @@ TEST_F(WebPage, OneFingerDragsToLookAndTwoDragToMove) {
   Camera want = scene_.camera;
   want.yaw_deg = turned["camera"]["yaw_deg"].get<double>();
   // The page moves once for each finger's move, half the centroid's motion each.
-  want = viewer::walk(scene_, want, 20.0 * scene_.scale / 200, 0.0, 0.0).camera;
-  want = viewer::walk(scene_, want, 20.0 * scene_.scale / 200, 0.0, 0.0).camera;
+  want = motion::walk(scene_, want, 20.0 * scene_.scale / 200, 0.0, 0.0).camera;
+  want = motion::walk(scene_, want, 20.0 * scene_.scale / 200, 0.0, 0.0).camera;
   EXPECT_EQ(moved["camera"]["polygon"].get<int>(), want.polygon);
   for (int k = 0; k < 3; ++k)
     EXPECT_NEAR(moved["camera"]["position"][k].get<double>(), want.position[k], 1e-9) << k;
@@ -141,7 +141,7 @@ TEST_F(WebPage, TheMouseLooksAndTheWheelWidensTheView) {
 
 TEST_F(WebPage, EpsAndOffsetKeysStepAsTheViewersAndRecompile) {
   open("l_shape");
-  viewer::MarchSettings viewer_settings{MarchParams{}};
+  motion::MarchSettings viewer_settings{MarchParams{}};
   // Up past the top of eps (offset carried up with it), then offset down until refused.
   for (int k = 0; k < 10; ++k) {
     key("]");

@@ -4,7 +4,7 @@
 #include <string>
 #include <utility>
 
-#include "backends/dynamic_library.hpp"
+#include "output/dynamic_library.hpp"
 
 namespace flatmarch::viewer {
 

@@ -18,14 +18,22 @@
 #include "backends/opengl/gl_kernel.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/compile.hpp"
+#include "motion/walk.hpp"
 #include "output/image_io.hpp"
 #include "scene/load.hpp"
 #include "viewer/controls.hpp"
 #include "viewer/glfw_api.hpp"
 #include "viewer/inset.hpp"
-#include "viewer/walk.hpp"
 
 namespace flatmarch::viewer {
+
+using motion::kDegreesPerPixel;
+using motion::kFastFactor;
+using motion::kSpeedPerScale;
+using motion::look;
+using motion::MarchSettings;
+using motion::RenderScale;
+using motion::walk;
 
 namespace {
 

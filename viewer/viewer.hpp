@@ -2,7 +2,7 @@
 // context in which the OpenGL backend's kernel program (backends/opengl/gl_kernel.hpp) draws
 // each frame at a fraction of the window's resolution, shown encoded to sRGB as `flatmarch
 // render` encodes its PNGs, with a floor-plan inset (viewer/inset.hpp). The camera walks through
-// glued walls (viewer/walk.hpp). Input comes from the keyboard and mouse or from a script
+// glued walls (motion/walk.hpp). Input comes from the keyboard and mouse or from a script
 // (viewer/script.hpp) through the same handlers.
 //
 // Controls, as in the paper's "Simulation Controls" plus the renderer's settings:

@@ -8,9 +8,9 @@
 
 #include "kernels/compile.hpp"
 #include "kernels/scene_shader.hpp"
+#include "motion/settings.hpp"
+#include "motion/walk.hpp"
 #include "scene/inspect.hpp"
-#include "viewer/controls.hpp"
-#include "viewer/walk.hpp"
 
 namespace flatmarch::web {
 
@@ -32,13 +32,13 @@ json pair(Vec2 v) {
   return {v.x, v.y};
 }
 
-// What the page's walk (a port of viewer/walk.cpp) needs of the scene: its band, and each
+// What the page's walk (a port of motion/walk.cpp) needs of the scene: its band, and each
 // polygon's edges with their gluings and an outline for the inside test (an unbounded room's cut
 // off far beyond where a walk may go, kWalkReach).
 json walk_data(const Scene& scene) {
   json polygons = json::array();
   for (const Polygon& polygon : scene.polygons) {
-    double reach = viewer::kWalkReach * scene.scale;
+    double reach = motion::kWalkReach * scene.scale;
     for (int i = 0; i < polygon.size(); ++i)
       if (!polygon.is_ideal(i)) reach = std::max(reach, glm::length(polygon.vertex(i)));
     json outline = json::array();
@@ -63,9 +63,9 @@ json walk_data(const Scene& scene) {
     }
     polygons.push_back({{"infinite", polygon.infinite()}, {"outline", outline}, {"edges", edges}});
   }
-  return {{"margin", viewer::kWalkMargin},
-          {"max_segments", viewer::kMaxSegments},
-          {"reach", viewer::kWalkReach},
+  return {{"margin", motion::kWalkMargin},
+          {"max_segments", motion::kMaxSegments},
+          {"reach", motion::kWalkReach},
           {"scale", scene.scale},
           {"height", scene.height},
           {"period", scene.period ? json(*scene.period) : json(nullptr)},
@@ -92,9 +92,9 @@ std::string page(const Scene& scene, const MarchParams& params, const PageOption
                {"method", to_string(params.method)},
                {"eps", params.eps},
                {"offset", params.offset},
-               {"eps_range", {viewer::kMinEps, viewer::kMaxEps}},
-               {"max_offset", viewer::kMaxOffset},
-               {"degrees_per_pixel", viewer::kDegreesPerPixel},
+               {"eps_range", {motion::kMinEps, motion::kMaxEps}},
+               {"max_offset", motion::kMaxOffset},
+               {"degrees_per_pixel", motion::kDegreesPerPixel},
                {"walk", walk_data(scene)},
                {"vertex_shader", kernel::kWebVertexShader},
                {"shaders", shaders}};

@@ -1,6 +1,6 @@
 // A scene as a self-contained web page that marches it with WebGL2 (issue 23): the kernel's
 // shader (kernels/march.glsl) in GLSL ES 3.00, specialised on the scene with its tables baked in,
-// the scene's camera, and the viewer's controls and walking (viewer/walk.cpp) ported to the
+// the scene's camera, and the viewer's controls and walking (motion/walk.cpp) ported to the
 // page's script (web/page.js). Nothing is fetched when it opens. `flatmarch export-web` writes
 // it; the webgl backend (backends/webgl) loads it in headless Chromium in read-back mode.
 #pragma once

@@ -30,7 +30,7 @@ function compile(type, source) {
   return shader;
 }
 
-// eps and offset as the viewer steps them (viewer/controls.hpp): by quarter decades from the
+// eps and offset as the viewer steps them (motion/settings.hpp): by quarter decades from the
 // export's values, eps within scene.eps_range, offset above eps and at most scene.max_offset.
 let epsSteps = 0, offsetSteps = 0;
 const quarterDecades = (start, steps) => start * Math.pow(10, steps / 4);
@@ -235,14 +235,14 @@ function look(dyaw, dpitch) {
   redraw();
 }
 
-// Walking (a port of viewer/walk.cpp: the same rules, in double precision): the horizontal path
+// Walking (a port of motion/walk.cpp: the same rules, in double precision): the horizontal path
 // is followed across glued edges, each crossing mapping the point and the rest of the path by
 // the edge's gluing and turning the yaw with it; mirrors and walls stop the walker kWalkMargin
 // short and the rest slides along them; a vertex stops it; z stays inside the band, or is taken
 // modulo the period of a prism; above or below the band the walker flies.
 const W = scene.walk;
 const { margin: kWalkMargin, max_segments: kMaxSegments, reach: kWalkReach } = W;
-const kVertexRadius = 1e-6, kPush = 1e-9;  // as viewer/walk.cpp's own
+const kVertexRadius = 1e-6, kPush = 1e-9;  // as motion/walk.cpp's own
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1];
 const cross2 = (a, b) => a[0] * b[1] - a[1] * b[0];
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1]];
@@ -392,7 +392,7 @@ function screenshot() {
 // window.flatmarchTimes holds every frame's milliseconds.
 const bench = Math.max(0, Math.min(1000, Number(query.get("bench")) || 0));
 // ?walk=F,R,U;F,R,U...: these walks from the scene's camera first; without ?frame the title then
-// says "flatmarch: walked " and the camera as JSON (tests compare it with viewer/walk.cpp's).
+// says "flatmarch: walked " and the camera as JSON (tests compare it with motion/walk.cpp's).
 let walked = null;
 if (query.get("walk") !== null) {
   let crossings = 0;

@@ -10,8 +10,8 @@
 #include <string>
 #include <utility>
 
-#include "backends/dynamic_library.hpp"
 #include "backends/opengl/platforms.hpp"
+#include "output/dynamic_library.hpp"
 
 namespace flatmarch::gl {
 

@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "backends/dynamic_library.hpp"
 #include "backends/opengl/platforms.hpp"
+#include "output/dynamic_library.hpp"
 
 namespace flatmarch::gl {
 

@@ -11,8 +11,8 @@
 #include "reports/gallery.hpp"
 #include "reports/matrix.hpp"
 #include "reports/report.hpp"
-#include "reports/surfaces.hpp"
 #include "scene/load.hpp"
+#include "scene/surfaces.hpp"
 #include "tests/process.hpp"
 
 namespace flatmarch::reports {

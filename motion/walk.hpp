@@ -5,7 +5,7 @@
 
 #include "scene/scene.hpp"
 
-namespace flatmarch::viewer {
+namespace flatmarch::motion {
 
 // Distance (scene units) at which a mirror, a wall or the top and bottom of the wall band stop
 // the walker, so that it never stands on them.
@@ -51,4 +51,4 @@ WalkResult walk(const Scene& scene, const Camera& camera, double forward, double
 // [-kMaxPitchDeg, kMaxPitchDeg]. Throws std::invalid_argument for non-finite angles.
 Camera look(const Camera& camera, double dyaw_deg, double dpitch_deg);
 
-}  // namespace flatmarch::viewer
+}  // namespace flatmarch::motion

@@ -1,4 +1,4 @@
-#include "reports/surfaces.hpp"
+#include "scene/surfaces.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "scene/load.hpp"
 
-namespace flatmarch::reports {
+namespace flatmarch {
 
 const std::vector<std::string>& surface_types() {
   static const std::vector<std::string> types = {
@@ -100,4 +100,4 @@ Scene empty_torus_prism() {
       "empty_torus_prism");
 }
 
-}  // namespace flatmarch::reports
+}  // namespace flatmarch

@@ -1,5 +1,6 @@
-// Surface types, by which the report groups scenes and recommends parameters, and the generated
-// surfaces of the scaling measurements: regular 2n-gons and staircases of squares.
+// Surface types, by which the report groups scenes and recommends parameters (and the tests and
+// benchmarks pick them), and the generated surfaces of the scaling measurements: regular 2n-gons
+// and staircases of squares.
 #pragma once
 
 #include <string>
@@ -7,7 +8,7 @@
 
 #include "scene/scene.hpp"
 
-namespace flatmarch::reports {
+namespace flatmarch {
 
 // The kinds of surface whose rays meet different hazards, in the order the report lists them:
 //   prism        a translation prism (z periodic): rays never escape, paths are long;
@@ -38,4 +39,4 @@ Scene staircase_surface(int squares, bool apart = false);
 // The torus of side 4 as a translation prism with nothing in it: path length is max_distance.
 Scene empty_torus_prism();
 
-}  // namespace flatmarch::reports
+}  // namespace flatmarch

@@ -1,4 +1,4 @@
-#include "backends/dynamic_library.hpp"
+#include "output/dynamic_library.hpp"
 
 #include <dlfcn.h>
 

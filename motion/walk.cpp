@@ -1,4 +1,4 @@
-#include "viewer/walk.hpp"
+#include "motion/walk.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace flatmarch::viewer {
+namespace flatmarch::motion {
 
 namespace {
 
@@ -181,4 +181,4 @@ Camera look(const Camera& camera, double dyaw_deg, double dpitch_deg) {
   return turned;
 }
 
-}  // namespace flatmarch::viewer
+}  // namespace flatmarch::motion
