@@ -17,8 +17,8 @@ if (($# != 2)); then
 fi
 build=$(cd "$1" && pwd) dest=$2
 root=$(cd "$(dirname "$0")/.." && pwd)
-programs=(cli/flatmarch bench/gpu_bench bench/simd_bench tests/opengl_test tests/vulkan_test
-  conformance/tests/device_paths_test)
+programs=(cli/flatmarch bench/gpu_bench bench/simd_bench backends/opengl/tests/opengl_test
+  backends/vulkan/tests/vulkan_test conformance/tests/device_paths_test)
 for p in "${programs[@]}"; do
   [[ -x $build/$p ]] || { echo "gpu_bundle: $build/$p is not built" >&2; exit 2; }
 done

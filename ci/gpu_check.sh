@@ -104,8 +104,9 @@ fi
 step report 200 "$flatmarch" report --skip-backend webgl --no-html -q -o "$out/report"
 step device_paths 45 env FLATMARCH_VULKAN_VALIDATION=1 \
   "$build/conformance/tests/device_paths_test" "${brief[@]}" --gtest_filter='*Shapes*'
-step opengl_test 40 "$build/tests/opengl_test" "${brief[@]}"
-step vulkan_test 40 env FLATMARCH_VULKAN_VALIDATION=1 "$build/tests/vulkan_test" "${brief[@]}"
+step opengl_test 40 "$build/backends/opengl/tests/opengl_test" "${brief[@]}"
+step vulkan_test 40 env FLATMARCH_VULKAN_VALIDATION=1 "$build/backends/vulkan/tests/vulkan_test" \
+  "${brief[@]}"
 step simd_bench 90 "$build/bench/simd_bench" \
   --benchmark_filter='/(l_shape|double_pentagon|cube|staircase_32)/' --benchmark_min_time=0.1 \
   --benchmark_out="$out/simd.json" --benchmark_out_format=json

@@ -427,7 +427,7 @@ function press(e) {
 function setMethod(name) {
   if (scene.shaders[name]) method = name;  // a page exported with its shader
 }
-// What the controls have set, for tests that drive the page (tests/web_page_test.cpp).
+// What the controls have set, for tests that drive the page (web/tests/web_page_test.cpp).
 window.flatmarchState = () => ({ camera, method, eps: eps(), offset: offset(),
                                  inset: plan ? !inset.hidden : null });
 // ?keys=K,K,...: these key presses first (tests: `]` raises eps a quarter decade).

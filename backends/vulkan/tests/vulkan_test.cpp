@@ -13,13 +13,13 @@
 
 #include "backends/scalar/scalar.hpp"
 #include "backends/vulkan/spirv.hpp"
+#include "backends/vulkan/tests/vulkan_backend.hpp"
 #include "kernels/scene_shader.hpp"
 #include "kernels/shader_log.hpp"
 #include "tests/gallery.hpp"
 #include "tests/gpu_backend_checks.hpp"
 #include "tests/oracle_compare.hpp"
 #include "tests/process.hpp"
-#include "tests/vulkan_backend.hpp"
 
 namespace flatmarch {
 namespace {

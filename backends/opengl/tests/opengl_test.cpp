@@ -15,11 +15,11 @@
 
 #include "backends/opengl/gl_kernel.hpp"
 #include "backends/opengl/opengl.hpp"
+#include "backends/opengl/tests/opengl_backend.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "kernels/scene_shader.hpp"
 #include "tests/gallery.hpp"
 #include "tests/gpu_backend_checks.hpp"
-#include "tests/opengl_backend.hpp"
 #include "tests/oracle_compare.hpp"
 #include "tests/process.hpp"
 
