@@ -107,6 +107,11 @@ HWY_INLINE VI Rank(M m) {
 constexpr Isa kIsa = HWY_TARGET <= HWY_AVX3   ? Isa::avx512
                      : HWY_TARGET == HWY_AVX2 ? Isa::avx2
                                               : Isa::sse4;
+// The modes (tuning.hpp's Mode) a frame of `job` may take on this target: its row's, less those
+// the job leaves to their fallbacks.
+inline uint32_t ModesAllowed(const PacketJob& job) {
+  return tuning(kIsa).modes & ~job.modes_off;
+}
 // The most vectors LookUp takes (Tuning::most_vectors is held to it).
 constexpr size_t kLookUpVectors = 4;
 

@@ -45,11 +45,31 @@ class Marcher : private RayEvents {
  public:
   Marcher(const PacketJob& job, std::vector<kernel::KernelEvent>* events, int max_events)
       : RayEvents(job, events, max_events),
-        whole_(job.tables->polygons.size() > 1 && solids_.by_lane() &&
-               walls_.whole(params_.method == kMethodAnalytic)),
+        whole_((ModesAllowed(job) & kModeWhole) != 0u && job.tables->polygons.size() > 1 &&
+               solids_.by_lane() && walls_.whole(params_.method == kMethodAnalytic)),
         one_room_(job.tables->polygons.size() == 1),
         nearest_(whole_ && walls_.glue_by_lane() && !walls_.same_rooms()),
         rooms_per_pass_(std::clamp(tuning(kIsa).rooms_per_pass, 1, kRoomsPerPass)) {}
+
+  // What a frame of this job takes (PacketModes); `nearest`: in the frame loop's copy that finds
+  // the analytic method's exit by the nearest line (MarchPacketsWith<true>).
+  PacketModes modes(bool nearest) const {
+    PacketModes m;
+    const bool analytic = params_.method == kMethodAnalytic;
+    const auto take = [&](Mode mode, bool taken) {
+      if (taken) m.modes |= mode;
+    };
+    take(kModeWhole, whole_);
+    take(kModeHeld, whole_ && !analytic && walls_.held() && !walls_.same_rooms());
+    take(kModeSameRooms, !one_room_ && walls_.same_rooms());
+    take(kModeAlike, !one_room_ && walls_.alike());
+    take(kModeBySlot, walls_.glue_by_slot());
+    take(kModeNearestLine, nearest && analytic && nearest_);
+    take(kModeOppositePairs, nearest && analytic && nearest_ && walls_.opposite_pairs());
+    m.passes = one_room_ ? "one room" : walls_.passes();
+    m.vectors = one_room_ ? 0 : walls_.vectors();
+    return m;
+  }
 
   // Edges held by no lane.
   static void clear(HeldEdges& held) {

@@ -48,6 +48,9 @@ int64_t RoomSteps(const PacketJob&, int64_t) {
 int TraceRay(const PacketJob&, const Ray&, int, std::vector<kernel::KernelEvent>*) {
   NotOffered();
 }
+PacketModes Modes(const PacketJob&) {
+  NotOffered();
+}
 #else
 // march.glsl's shade(): the colour of finished rays, linear and tone-mapped.
 HWY_INLINE void Shade(const KernelParams& params, const Packet& r, V& red, V& green, V& blue) {
@@ -300,18 +303,23 @@ HWY_NOINLINE void MarchPacketsWith(const PacketJob& job, TileBlocks& blocks, int
 // (double pentagon 0.94x, cube 0.98x) on the frames that never take it (4-square staircase
 // 1.04-1.09x, L-shape 1.02-1.04x: the code around the step compiled differently, NOTES.md); in a
 // copy of its own those are compiled as before. The copy is compiled only for the instruction
-// sets whose tuning takes it (Tuning::nearest_line; every one in a probe build): a copy for
-// every instruction set made this file's compile 196 -> 256 s (-O2 -g, one core; AVX-512's
+// sets whose tuning takes it (kModeNearestLine in Tuning::modes; every one in a probe build): a
+// copy for every instruction set made this file's compile 196 -> 256 s (-O2 -g, one core; AVX-512's
 // alone, 216 s).
 #ifdef FLATMARCH_SIMD_TUNING_PROBE
 constexpr bool kNearestLineCompiled = true;
 #else
-constexpr bool kNearestLineCompiled = tuning(kIsa).nearest_line;
+constexpr bool kNearestLineCompiled = tuning(kIsa).takes(kModeNearestLine);
 #endif
+// Whether a frame of `job` takes the nearest line's copy.
+bool NearestLineCopy(const PacketJob& job) {
+  return kNearestLineCompiled && job.exit_by_nearest_line &&
+         (ModesAllowed(job) & kModeNearestLine) != 0u;
+}
 template <bool kCompiled>
 void MarchPacketsChosen(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
   if constexpr (kCompiled) {
-    if (job.exit_by_nearest_line && tuning(kIsa).nearest_line) {
+    if (NearestLineCopy(job)) {
       MarchPacketsWith<true>(job, blocks, part, lanes);
       return;
     }
@@ -320,6 +328,10 @@ void MarchPacketsChosen(const PacketJob& job, TileBlocks& blocks, int part, Lane
 }
 void MarchPackets(const PacketJob& job, TileBlocks& blocks, int part, LaneCounts* lanes) {
   MarchPacketsChosen<kNearestLineCompiled>(job, blocks, part, lanes);
+}
+
+PacketModes Modes(const PacketJob& job) {
+  return Marcher(job, nullptr, 0).modes(NearestLineCopy(job));
 }
 
 // The rays of the frame's central tile (a packet's worth, clamped to the frame), started from the
@@ -419,6 +431,7 @@ HWY_EXPORT(PacketLanes);
 HWY_EXPORT(MarchPackets);
 HWY_EXPORT(TraceRay);
 HWY_EXPORT(RoomSteps);
+HWY_EXPORT(Modes);
 
 int64_t compiled_targets() {
   return HWY_TARGETS;
@@ -432,7 +445,8 @@ PacketCode packet_code(int64_t target) {
   if (target != 0) hwy::SetSupportedTargetsForTest(target);
   hwy::GetChosenTarget().Update(hwy::SupportedTargets());
   PacketCode code{&HWY_DYNAMIC_DISPATCH(PacketLanes), &HWY_DYNAMIC_DISPATCH(MarchPackets),
-                  &HWY_DYNAMIC_DISPATCH(TraceRay), &HWY_DYNAMIC_DISPATCH(RoomSteps)};
+                  &HWY_DYNAMIC_DISPATCH(TraceRay), &HWY_DYNAMIC_DISPATCH(RoomSteps),
+                  &HWY_DYNAMIC_DISPATCH(Modes)};
   if (target != 0) {
     hwy::SetSupportedTargetsForTest(0);
     hwy::GetChosenTarget().Update(hwy::SupportedTargets());

@@ -32,6 +32,9 @@ struct PacketJob {
   // The analytic method's whole passes find their exit edge by the nearest line first (the same
   // exit: nearest-inl.h): in scenes of several convex rooms not alike, where it saves work.
   bool exit_by_nearest_line = false;
+  // Modes (tuning.hpp's Mode) this job leaves to their fallbacks whatever the instruction set's
+  // tuning takes: the tests run each mode's fallback on every instruction set.
+  uint32_t modes_off = 0;
 
   // A frame: pixels [0, width) x [0, height) seen from `camera`.
   CameraBasis<float> basis{};
@@ -123,6 +126,17 @@ class TileBlocks {
   alignas(64) std::atomic<int64_t> taken_{0};
 };
 
+// What the packets of a frame take on one instruction set: the modes (tuning.hpp's Mode bits)
+// and how a pass over the rays of several rooms reads their edges.
+struct PacketModes {
+  uint32_t modes = 0;
+  // "one room" (the scene's only room), "lookup" (each lane's edges looked up in `vectors`
+  // vectors of the scene's edges), "blend" (each room's broadcast and blended by lane) or
+  // "single" (one room a pass).
+  const char* passes = "";
+  int vectors = 0;
+};
+
 // The per-target entry points of packet.cpp, for one instruction set.
 struct PacketCode {
   // Lanes per vector: the rays in a packet.
@@ -141,6 +155,8 @@ struct PacketCode {
   // starts done). Timed, it is the most lane-steps a second a core makes on this scene and
   // method: no lane idle, no pixel to shade or write, the tables in cache.
   int64_t (*room_steps)(const PacketJob& job, int64_t repeats);
+  // What a frame of `job` takes on this instruction set (PacketModes).
+  PacketModes (*modes)(const PacketJob& job);
 };
 
 // The Highway targets (HWY_SSE4, HWY_AVX2, ...) packet.cpp was compiled for.

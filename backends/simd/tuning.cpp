@@ -21,7 +21,8 @@ const char* isa_name(Isa isa) {
 
 #ifdef FLATMARCH_SIMD_TUNING_PROBE
 namespace {
-// "[isa.]name=value" pairs, comma-separated, applied to `t` where they name `isa` or none.
+// "[isa.]name=value" pairs, comma-separated, applied to `t` where they name `isa` or none: a
+// threshold's value, or a mode's (kModeNames) 1 to take it where a scene allows, 0 to leave it.
 void override_from(const std::string& text, Isa isa, Tuning& t) {
   size_t at = 0;
   while (at < text.size()) {  // bounded: every turn moves past a comma or the end
@@ -63,8 +64,12 @@ void override_from(const std::string& text, Isa isa, Tuning& t) {
       t.most_vectors_analytic = value;
     else if (name == "rooms_per_pass")
       t.rooms_per_pass = value;
-    else if (name == "nearest_line")
-      t.nearest_line = value != 0;
+    else if (name == "held_over_lookup")
+      t.held_over_lookup = value != 0;
+    else if (const auto mode = std::find_if(kModeNames.begin(), kModeNames.end(),
+                                            [&](const ModeName& m) { return name == m.name; });
+             mode != kModeNames.end())
+      t.modes = value != 0 ? t.modes | mode->mode : t.modes & ~static_cast<uint32_t>(mode->mode);
     else
       throw std::invalid_argument("FLATMARCH_SIMD_TUNE: unknown value " + name);
   }

@@ -7,11 +7,54 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
 
 namespace flatmarch::simd {
 
 enum class Isa { avx512, avx2, sse4 };
+
+// The packet code's modes: ways of running a step that a scene's shape allows and that save work
+// there, each with a fallback that gives the same frames bit for bit (simd_test's
+// EveryModeAndItsFallback runs both on every instruction set the CPU runs). What each is for,
+// where it runs and what keeps it: the table of modes below kTunings.
+enum Mode : uint32_t {
+  // Rays over several rooms take one pass a step, each lane's edges read by its room alone
+  // (Rooms::whole); fallback: passes over up to rooms_per_pass rooms, each broadcast and blended.
+  kModeWhole = 1u << 0,
+  // In those passes (sphere and relaxed tracing, rooms of at most five edges), each lane holds
+  // its room's edges (HeldEdges); fallback: looked up in vectors, or no whole pass.
+  kModeHeld = 1u << 1,
+  // Rooms alike in every number (squares drawn in one place) read by broadcast, whole passes
+  // without walls; fallback: each lane's edges looked up or blended.
+  kModeSameRooms = 1u << 2,
+  // An edge slot's number alike in every room (the cube's normals) read by broadcast, and a
+  // gluing's number alike at every edge; fallback: looked up or blended by lane.
+  kModeAlike = 1u << 3,
+  // Crossings in scenes glued alike slot by slot read the gluing by slot (SlotGluings) where the
+  // edges do not fit in vectors; fallback: a round per room and edge crossed.
+  kModeBySlot = 1u << 4,
+  // The analytic method's whole passes over convex rooms not alike find their exit by the
+  // nearest line first (nearest-inl.h), in a copy of the frame loop that carries the exit's
+  // cosine and index to the crossing; fallback: every edge tested, the crossing's own lookups.
+  kModeNearestLine = 1u << 5,
+  // In that search, rooms of two opposite pairs of edges (the cube's faces) measure one line a
+  // pair; fallback: every line.
+  kModeOppositePairs = 1u << 6,
+};
+inline constexpr uint32_t kEveryMode = (1u << 7) - 1;
+// Each mode's name (FLATMARCH_SIMD_TUNE's, simd_bench's and the tests').
+struct ModeName {
+  Mode mode;
+  const char* name;
+};
+inline constexpr std::array<ModeName, 7> kModeNames{{{kModeWhole, "whole"},
+                                                     {kModeHeld, "held"},
+                                                     {kModeSameRooms, "same_rooms"},
+                                                     {kModeAlike, "alike"},
+                                                     {kModeBySlot, "by_slot"},
+                                                     {kModeNearestLine, "nearest_line"},
+                                                     {kModeOppositePairs, "opposite_pairs"}}};
 
 struct Tuning {
   // Lanes wait for a new pixel until this many eighths of them do (packet.cpp's refill rule):
@@ -52,10 +95,16 @@ struct Tuning {
   // rooms (1 to lanes-inl.h's kRoomsPerPass, 8): more rooms a pass, fewer passes a step, each
   // dearer.
   int rooms_per_pass = 8;
-  // The analytic method's whole passes over convex rooms not alike find their exit by the nearest
-  // line first (nearest-inl.h), in a copy of the frame loop of its own, compiled only where this
-  // is set (compile time: a copy for every instruction set made packet.cpp's compile 196 -> 256 s).
-  bool nearest_line = false;
+  // Where a pass over several rooms looks their edges up in vectors (most_vectors), lanes hold
+  // their rooms' edges all the same (kModeHeld): a load of a held edge against a lookup in one or
+  // two vectors.
+  bool held_over_lookup = true;
+  // The modes (Mode, below) this instruction set may take: each where a scene allows it, its
+  // fallback elsewhere. The nearest line's copy of the frame loop is compiled only where a row
+  // takes it (compile time: a copy for every instruction set made packet.cpp's compile 196 ->
+  // 256 s).
+  uint32_t modes = kEveryMode & ~kModeNearestLine;
+  constexpr bool takes(uint32_t mode) const { return (modes & mode) == mode; }
 };
 
 // The values, by instruction set. Each was measured on that instruction set, one thread unless
@@ -87,9 +136,49 @@ struct Tuning {
 // | rooms_per_pass        | 8      | 8    | 8    | avx512: 4 level, fewer lanes busy; sse4 at   |
 // |                       |        |      |      | 1: analytic cube 1.139, double pentagon      |
 // |                       |        |      |      | 0.919 (within the noise)                     |
-// | nearest_line          | on     | on   | -    | avx512: cube, double pentagon 0.94-0.98x;    |
-// |                       |        |      |      | avx2 alone (most_vectors_analytic 2): double |
-// |                       |        |      |      | pentagon 0.911, with 3 above                 |
+//
+// | held_over_lookup      | off    | on   | on   | avx512 off: lookups in one or two vectors    |
+// |                       |        |      |      | 0.94-0.97x the time of held edges (sphere    |
+// |                       |        |      |      | and relaxed: cube, pillowcase, double        |
+// |                       |        |      |      | pentagon, two-room affine torus; best of 6), |
+// |                       |        |      |      | controls 0.995-1.001                         |
+//
+// The modes (Mode), by instruction set: taken where the row has them and a scene allows, the
+// fallback elsewhere. Each measured against its fallback on each instruction set (the probe,
+// `bench/ab.py P P --base-env FLATMARCH_SIMD_TUNE=MODE=1 --new-env FLATMARCH_SIMD_TUNE=MODE=0
+// --rounds 4 --pin 1`, one thread, Zen 5, 2026-12-05; the L-shape's one room as control, within 3%
+// but where said): the time of the frames it governs without it over with it, avx512 / avx2 /
+// sse4. A mode within 2% of its fallback on every instruction set measured goes.
+//
+// | mode           | avx512 | avx2 | sse4 | without it / with it                               |
+// |----------------|--------|------|------|----------------------------------------------------|
+// | whole          | on     | on   | on   | sphere: cube 1.32 / 1.35 / 1.35, double pentagon   |
+// |                |        |      |      | 1.23 / 1.39 / 1.43, 32-square staircase 1.52 /     |
+// |                |        |      |      | 1.30 / 1.26; analytic: cube 1.40 / 1.26 / 1.03,    |
+// |                |        |      |      | double pentagon 1.18 / 1.22 / 0.98                 |
+// | held           | on (a) | on   | on   | sphere: cube (a) / 1.35 / 1.33, double pentagon    |
+// |                |        |      |      | (a) / 1.12 / 1.36; relaxed: cube (a) / 1.28 /      |
+// |                |        |      |      | 1.28, double pentagon (a) / 1.08 / 1.42. (a): only |
+// |                |        |      |      | where edges are not looked up (held_over_lookup)   |
+// | same_rooms     | on     | on   | off  | 32-square staircase: sphere 1.08 (1.11 in a first  |
+// |                |        |      |      | run) / 1.01 / 0.98, analytic 1.04 / 0.99 / 0.91.   |
+// |                |        |      |      | sse4 off (best of 6): analytic staircases of 32    |
+// |                |        |      |      | and 128 squares 0.907x the time, 4 squares 0.994,  |
+// |                |        |      |      | sphere and relaxed 1.016-1.020, controls level     |
+// | alike          | on     | on   | on   | analytic: cube 1.06 / 1.18 / 1.19, double pentagon |
+// |                |        |      |      | 1.03 / 1.04 / 1.09 (controls 1.02-1.04); sphere:   |
+// |                |        |      |      | cube 1.05 / 0.99 / 0.98 (a first run 1.07 / 1.03 / |
+// |                |        |      |      | 1.06)                                              |
+// | by_slot        | on     | on   | (b)  | analytic staircases of 32 and 128 squares 1.27-    |
+// |                |        |      |      | 1.28 / 1.22-1.26. (b): SSE4's two vectors hold 8   |
+// |                |        |      |      | tints, under the staircases' 10: never taken       |
+// | nearest_line   | on     | on   | off  | analytic cube, double pentagon (2026-12-02, best   |
+// |                |        |      |      | of 6): 1.02-1.06 / 1.20 and 1.08 (with             |
+// |                |        |      |      | most_vectors_analytic 3) / 0.96 (7 of 12 cases     |
+// |                |        |      |      | faster without); on an Intel Xeon 1.20 and 1.14 /  |
+// |                |        |      |      | 1.12 and 1.19 / level (NOTES.md)                   |
+// | opposite_pairs | on     | on   | -    | analytic cube 1.05 (control 1.03: level) / 1.08    |
+// |                |        |      |      | (1.09 in a first run); taken with nearest_line     |
 //
 // And where the targets' instructions differ, each takes its own way (lanes-inl.h):
 // - a lookup in two vectors: one `vpermt2ps` on AVX-512 (two and a blend for three or four); a
@@ -105,9 +194,9 @@ struct Tuning {
 //   on a Zen 4's AVX-512).
 // The rows: the defaults above where an instruction set keeps them, and what it sets apart.
 inline constexpr std::array<Tuning, 3> kTunings{{
-    {.nearest_line = true},                              // avx512
-    {.most_vectors_analytic = 3, .nearest_line = true},  // avx2
-    {},                                                  // sse4
+    {.held_over_lookup = false, .modes = kEveryMode},              // avx512
+    {.most_vectors_analytic = 3, .modes = kEveryMode},             // avx2
+    {.modes = kEveryMode & ~(kModeNearestLine | kModeSameRooms)},  // sse4
 }};
 
 // The tuning of `isa`: kTunings', or, in a build with FLATMARCH_SIMD_TUNING_PROBE defined (for

@@ -50,23 +50,27 @@ class Walls {
     const size_t edges = tables.edges.size(), lanes = hn::Lanes(D());
     vectors_ = (std::max(edges, tables.polygons.size()) + lanes - 1) / lanes;
     const Tuning tune = tuning(kIsa);
+    const uint32_t modes = ModesAllowed(job);
     const size_t most_vectors = static_cast<size_t>(std::clamp(
         tables.params.method == kMethodAnalytic ? tune.most_vectors_analytic : tune.most_vectors, 1,
         static_cast<int>(kLookUpVectors)));
     mode_ = vectors_ <= most_vectors ? kTable : edges <= kMostEdges ? kBlend : kSingle;
-    if (mode_ != kTable && t.glue_by_slot && static_cast<size_t>(t.most_edges) <= lanes &&
-        t.tints.size() <= 2 * lanes)
+    if ((modes & kModeBySlot) != 0u && mode_ != kTable && t.glue_by_slot &&
+        static_cast<size_t>(t.most_edges) <= lanes && t.tints.size() <= 2 * lanes)
       by_slot_.take(t);
     if (mode_ == kSingle) return;
     most_edges_ = t.most_edges;
-    held_ = tables.params.method != kMethodAnalytic && tables.polygons.size() > 1 &&
+    held_ = (modes & kModeHeld) != 0u && (tune.held_over_lookup || mode_ != kTable) &&
+            tables.params.method != kMethodAnalytic && tables.polygons.size() > 1 &&
             std::all_of(tables.polygons.begin(), tables.polygons.end(),
                         [](const ivec4& p) { return p.y <= kHeldEdges; });
     same_first_edge_ = t.same_first_edge;
     same_count_ = t.same_count;
-    same_rooms_ = t.same_rooms;
-    alike_ = t.alike;
-    alike_number_ = t.alike_number;
+    same_rooms_ = (modes & kModeSameRooms) != 0u && t.same_rooms;
+    if ((modes & kModeAlike) != 0u) {
+      alike_ = t.alike;
+      alike_number_ = t.alike_number;
+    }
     if (mode_ == kBlend) {  // broadcasts of the edges' numbers: no zeros needed past them
       const size_t from = same_rooms_ ? static_cast<size_t>(same_first_edge_) : 0;
       const size_t count = same_rooms_ ? static_cast<size_t>(most_edges_) : edges;
@@ -93,19 +97,36 @@ class Walls {
     copy(wall_, t.wall);
     copy(to_polygon_, t.to_polygon);
     for (size_t f = 0; f < kGlueFields; ++f) copy(glue_[f], t.glue[f]);
-    glue_alike_ = t.glue_alike;
-    glue_number_ = t.glue_number;
+    if ((modes & kModeAlike) != 0u) {
+      glue_alike_ = t.glue_alike;
+      glue_number_ = t.glue_number;
+    }
     const auto opposite = [&](size_t k, size_t j) {
       const uint32_t both = (1u << k) | (1u << j);
       return (alike_[kNx] & both) == both && (alike_[kNy] & both) == both &&
              alike_number_[kNx][j] == -alike_number_[kNx][k] &&
              alike_number_[kNy][j] == -alike_number_[kNy][k];
     };
-    opposite_pairs_ = most_edges_ == 4 && same_count_ && opposite(0, 2) && opposite(1, 3);
+    opposite_pairs_ = (modes & kModeOppositePairs) != 0u && most_edges_ == 4 && same_count_ &&
+                      opposite(0, 2) && opposite(1, 3);
   }
 
   // Whether a pass may span several rooms (up to kMostEdges edges in the scene).
   bool merge() const { return mode_ != kSingle; }
+  // How a pass over several rooms reads its lanes' edges (PacketModes::passes), and in how many
+  // vectors where it looks them up.
+  const char* passes() const {
+    return mode_ == kTable ? "lookup" : mode_ == kBlend ? "blend" : "single";
+  }
+  int vectors() const { return mode_ == kTable ? static_cast<int>(vectors_) : 0; }
+  // Whether passes over several rooms read some number alike in every room by broadcast
+  // (kModeAlike): an edge's, or a gluing's in crossings looked up by lane.
+  bool alike() const {
+    const bool edge_alike =
+        merge() && !same_rooms_ &&
+        std::any_of(alike_.begin(), alike_.end(), [](uint32_t bits) { return bits != 0u; });
+    return edge_alike || (glue_by_lane() && glue_alike_ != 0u);
+  }
   // Whether whole passes read the edges each lane holds (HeldEdges) rather than look them up:
   // sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges.
   bool held() const { return held_; }

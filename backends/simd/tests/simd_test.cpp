@@ -11,6 +11,7 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -19,6 +20,7 @@
 #include "backends/scalar/scalar.hpp"
 #include "backends/simd/packet.hpp"
 #include "backends/simd/simd.hpp"
+#include "backends/simd/tuning.hpp"
 #include "scene/load.hpp"
 #include "scene/surfaces.hpp"
 #include "tests/gallery.hpp"
@@ -230,22 +232,108 @@ TEST(Simd, WholePassesLookingEdgesUpAgreeWithScalar) {
   }
 }
 
-// A frame of `scene` marched by the best instruction set's packets on one thread, its exit edges
-// found by the nearest line first where `nearest` (simd::PacketJob::exit_by_nearest_line; the
-// instruction sets below AVX-512 ignore it).
+// A frame of `scene` marched by `isa`'s packets on one thread, its exit edges found by the
+// nearest line first where `nearest` and the instruction set's tuning takes it
+// (simd::PacketJob::exit_by_nearest_line), with the modes of `modes_off` left to their fallbacks
+// (simd::PacketJob::modes_off); what the frame took in `taken` where not null.
 Frame packet_frame(const Scene& scene, const MarchParams& params, int width, int height,
-                   bool nearest, const std::string& isa) {
+                   bool nearest, const std::string& isa, uint32_t modes_off = 0,
+                   simd::PacketModes* taken = nullptr) {
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, params);
   Frame frame(width, height);
   simd::PacketJob job = simd::frame_job(tables, scene.camera, width, height, frame);
   job.exit_by_nearest_line = nearest;
+  job.modes_off = modes_off;
   const simd::PacketCode code = simd::packet_code(simd::isa_target(isa));
+  if (taken) *taken = code.modes(job);
   const simd::TileShape tile = simd::tile_shape(code.lanes());
   simd::TileBlocks blocks((height + tile.height - 1) / tile.height,
                           (width + tile.width - 1) / tile.width, 1);
   simd::LaneCounts lanes;
   code.march(job, blocks, 0, &lanes);
   return frame;
+}
+
+simd::Isa isa_of(const std::string& name) {
+  for (simd::Isa isa : {simd::Isa::avx512, simd::Isa::avx2, simd::Isa::sse4})
+    if (name == simd::isa_name(isa)) return isa;
+  throw std::invalid_argument("no instruction set " + name);
+}
+
+// Each mode of the packet code (simd::Mode, tuning.hpp's table of modes), with a scene and method
+// that allow it and the instruction sets that take it there: those whose tuning row takes it and
+// whose vectors hold what it reads. On every instruction set this CPU runs, the frame takes the
+// mode exactly there, and gives the scalar backend's frame bit for bit both with the mode and with
+// it left to its fallback (PacketJob::modes_off): a mode that one target alone takes is tested on
+// its fallback on the others.
+TEST(Simd, EveryModeAndItsFallbackOnEveryInstructionSet) {
+  const Scene& cube = test::gallery_scene("cube");
+  const Scene staircase = staircase_surface(32, false);  // every square drawn in one place
+  const Scene apart = staircase_surface(32, true);       // 128 edges: looked up in no vectors
+  // Whether the cube's 24 edges are looked up in vectors of this instruction set's lanes (in at
+  // most Tuning::most_vectors, or most_vectors_analytic): the nearest line's search reads them by
+  // lane, and lanes hold them only where the row holds edges that can be looked up.
+  const auto cube_edges_fit = [](simd::Isa isa, bool analytic) {
+    const int lanes = isa == simd::Isa::avx512 ? 16 : isa == simd::Isa::avx2 ? 8 : 4;
+    const simd::Tuning& row = simd::kTunings[static_cast<size_t>(isa)];
+    return (24 + lanes - 1) / lanes <= (analytic ? row.most_vectors_analytic : row.most_vectors);
+  };
+  const auto cube_looked_up = [&](simd::Isa isa) { return cube_edges_fit(isa, true); };
+  const auto cube_held = [&](simd::Isa isa) {
+    return simd::kTunings[static_cast<size_t>(isa)].held_over_lookup || !cube_edges_fit(isa, false);
+  };
+  struct ModeCase {
+    simd::Mode mode;
+    const Scene* scene;
+    Method method;
+    std::function<bool(simd::Isa)> fits;  // besides its tuning row, where the mode is taken
+  };
+  const auto everywhere = [](simd::Isa) { return true; };
+  const std::vector<ModeCase> cases{
+      // Six rooms of four edges (held), their normals alike slot by slot (alike).
+      {simd::kModeWhole, &cube, Method::sphere, everywhere},
+      {simd::kModeHeld, &apart, Method::sphere, everywhere},
+      {simd::kModeHeld, &cube, Method::relaxed, cube_held},
+      {simd::kModeAlike, &cube, Method::sphere, everywhere},
+      {simd::kModeSameRooms, &staircase, Method::sphere, everywhere},
+      // The staircase's ten tints in two vectors: SSE4's hold eight.
+      {simd::kModeBySlot, &staircase, Method::analytic,
+       [](simd::Isa isa) { return isa != simd::Isa::sse4; }},
+      {simd::kModeNearestLine, &cube, Method::analytic, cube_looked_up},
+      {simd::kModeOppositePairs, &cube, Method::analytic, cube_looked_up},
+  };
+  for (const simd::ModeName& m : simd::kModeNames)
+    EXPECT_TRUE(std::any_of(cases.begin(), cases.end(),
+                            [&](const ModeCase& c) { return c.mode == m.mode; }))
+        << "a case for " << m.name;
+  for (const ModeCase& c : cases) {
+    const std::string name = std::find_if(simd::kModeNames.begin(), simd::kModeNames.end(),
+                                          [&](const simd::ModeName& m) { return m.mode == c.mode; })
+                                 ->name;
+    MarchParams params;
+    params.method = c.method;
+    if (c.scene == &staircase || c.scene == &apart) params.max_distance = 40.0;
+    const bool nearest =
+        simd::packet_job(kernel::compile_scene<float>(*c.scene, params)).exit_by_nearest_line;
+    const Frame scalar = ScalarBackend().render(*c.scene, c.scene->camera, 64, 36, params, {});
+    for (const std::string& isa : simd::isa_names(true)) {
+      const simd::Isa which = isa_of(isa);
+      const bool expected =
+          simd::kTunings[static_cast<size_t>(which)].takes(c.mode) && c.fits(which);
+      const std::string what =
+          name + " (" + c.scene->name + ", " + to_string(c.method) + ") " + isa;
+      simd::PacketModes with, without;
+      const Frame on = packet_frame(*c.scene, params, 64, 36, nearest, isa, 0, &with);
+      EXPECT_EQ((with.modes & c.mode) != 0u, expected) << what;
+      expect_identical(compare(scalar, on), what);
+      const Frame off = packet_frame(*c.scene, params, 64, 36, nearest, isa, c.mode, &without);
+      EXPECT_EQ(without.modes & c.mode, 0u) << what << ", left to its fallback";
+      expect_identical(compare(scalar, off), what + ", left to its fallback");
+      std::cout << "[ modes    ] " << what << ": "
+                << ((with.modes & c.mode) ? "taken" : "not taken") << ", passes " << with.passes
+                << "\n";
+    }
+  }
 }
 
 // The analytic method's exit by the nearest line (nearest-inl.h) takes the scenes of several
@@ -267,8 +355,8 @@ TEST(Simd, ExitByTheNearestLineAgreesWithScalar) {
   sphere.method = Method::sphere;
   EXPECT_FALSE(taken(test::gallery_scene("cube"), sphere));
 
-  // AVX-512's packets have a copy of the frame loop that finds the exit this way
-  // (simd::Tuning::nearest_line); the other instruction sets take the loop without it for the
+  // The instruction sets whose tuning takes the nearest line (simd::kModeNearestLine) have a copy
+  // of the frame loop that finds the exit this way; the others take the loop without it for the
   // same job, and must give the same frames.
   const Scene hexagon = hexagon_and_square();
   for (const Scene* scene :
