@@ -232,3 +232,14 @@ KINLINE real tone_curve(real c) {
 KINLINE vec3 tone_map(vec3 c) {
   return vec3(tone_curve(c.x), tone_curve(c.y), tone_curve(c.z));
 }
+
+#ifdef FLATMARCH_SHADER
+// The sRGB transfer function (IEC 61966-2-1) of a linear colour, clamped to [0, 1]: as OpenImageIO
+// encodes the PNGs of `render` (output/image_io.cpp), for the shaders that show or read back
+// colour alone (the scene shaders' colour frames and web canvas, the viewer's window). The CPU
+// backends leave the encoding to the image writer, so it is compiled as GLSL only.
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+#endif

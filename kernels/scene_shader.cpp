@@ -47,15 +47,6 @@ std::string array(bool constant, const char* type, const char* name,
   return s;
 }
 
-// The sRGB transfer function (IEC 61966-2-1), as OpenImageIO encodes the PNGs of `render`: for
-// the web page's canvas and the frames of the colour alone (Readback::colour).
-const char* const kSrgb = R"glsl(
-vec3 srgb(vec3 c) {
-  c = clamp(c, 0.0, 1.0);
-  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
-)glsl";
-
 const char* const kFragmentMain = R"glsl(
 uniform int u_polygon;
 uniform vec3 u_from;
@@ -240,7 +231,7 @@ bool within_band(const SceneTables<float>& tables, const glm::dvec3& position) {
 
 std::string scene_fragment_shader(const SceneTables<float>& tables, const ShaderVariant& v) {
   return shader_source(tables.features, baked_tables(tables) + variant_defines(v), v.trace) +
-         kSrgb + kFragmentMain;
+         kFragmentMain;
 }
 
 std::string scene_compute_shader(const SceneTables<float>& tables, const ShaderVariant& v,
@@ -250,7 +241,7 @@ std::string scene_compute_shader(const SceneTables<float>& tables, const ShaderV
   return shader_source(tables.features, baked_tables(tables, false) + variant_defines(compute),
                        v.trace) +
          (api == ComputeApi::opengl ? "#define FLATMARCH_GL_COMPUTE\n" : "") + "#define TILE " +
-         std::to_string(kComputeTile) + "\n" + kSrgb + kComputeMain;
+         std::to_string(kComputeTile) + "\n" + kComputeMain;
 }
 
 namespace {
@@ -269,9 +260,8 @@ std::string web_fragment_shader(const SceneTables<float>& tables, WebShader kind
                                  "#define FLATMARCH_TRACE_PICK\n"};
   // Plain global arrays, not constants: SwiftShader (Chromium's WebGL without a GPU) crashes its
   // GPU process on a struct read from a constant array at an index known only at run time.
-  return as_glsl_es(
-      shader_source(tables.features, baked_tables(tables, false)) + kSrgb + kFragmentMain,
-      defines[static_cast<int>(kind)]);
+  return as_glsl_es(shader_source(tables.features, baked_tables(tables, false)) + kFragmentMain,
+                    defines[static_cast<int>(kind)]);
 }
 
 const char* const kWebVertexShader = R"glsl(#version 300 es

@@ -19,6 +19,10 @@ extern const char* const kBufferTables;
 // `trace`, record_event appends to the event buffer (binding 4) instead of doing nothing.
 std::string shader_source(uint features, const std::string& tables, bool trace = false);
 
+// The kernel's constants and per-lane maths (kernels/maths.glsl) alone, without `#version`, for a
+// shader of its own that calls them (the viewer's window: srgb()).
+std::string maths_source();
+
 // With the tables as buffers.
 inline std::string shader_source(uint features) {
   return shader_source(features, kBufferTables);

@@ -18,6 +18,7 @@
 #include "backends/opengl/gl_kernel.hpp"
 #include "kernels/camera.hpp"
 #include "kernels/compile.hpp"
+#include "kernels/shader_source.hpp"
 #include "motion/walk.hpp"
 #include "output/image_io.hpp"
 #include "scene/load.hpp"
@@ -56,18 +57,18 @@ void main() {
 }
 )glsl";
 
-// The linear colour encoded to sRGB (IEC 61966-2-1), clamped, as OpenImageIO's "linear" to
-// "sRGB" conversion encodes the PNGs of `flatmarch render` (output/image_io.cpp).
-const char* const kPresentFragmentShader = R"glsl(#version 450 core
+// The linear colour encoded to sRGB (kernels/maths.glsl's srgb(), clamped), as OpenImageIO's
+// "linear" to "sRGB" conversion encodes the PNGs of `flatmarch render` (output/image_io.cpp).
+std::string present_fragment_shader() {
+  return "#version 450 core\n" + kernel::maths_source() + R"glsl(
 uniform sampler2D u_colour;
 in vec2 v_uv;
 layout(location = 0) out vec4 o_colour;
 void main() {
-  vec3 c = clamp(texture(u_colour, v_uv).rgb, 0.0, 1.0);
-  o_colour = vec4(mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055,
-                      step(vec3(0.0031308), c)), 1.0);
+  o_colour = vec4(srgb(texture(u_colour, v_uv).rgb), 1.0);
 }
 )glsl";
+}
 
 const char* const kInsetVertexShader = R"glsl(#version 450 core
 layout(location = 0) in vec2 a_position;  // window pixels, y down
@@ -252,7 +253,7 @@ Viewer::Viewer(const ViewerOptions& options)
   // A script runs as fast as it draws; a person gets frames paced by the display.
   glfw().SwapInterval(options.scripted ? 0 : 1);
 
-  present_ = gl::link_program(gl_, kPresentVertexShader, kPresentFragmentShader);
+  present_ = gl::link_program(gl_, kPresentVertexShader, present_fragment_shader());
   inset_program_ = gl::link_program(gl_, kInsetVertexShader, kInsetFragmentShader);
   inset_window_ = gl_.GetUniformLocation(inset_program_, "u_window");
   gl_.GenVertexArrays(1, &empty_vertex_array_);
