@@ -405,17 +405,21 @@ std::vector<ArgCase> shared_option_cases() {
       {"max_steps_huge", {"--max-steps", "200000000"}, "--max-steps: must lie in [1, 1e8]"},
       {"isa_unknown", {"--isa", "avx9000"}, "--isa: unknown instruction set \"avx9000\""},
       {"threads_negative", {"--threads", "-1"}, "--threads: must be 0 (all cores) or more"}};
-  // --isa is an option of a backend that may be left out of a build (FLATMARCH_WITH_<NAME>).
-  const bool isa_taken =
-      std::any_of(backend_registry().begin(), backend_registry().end(), [](const BackendEntry& e) {
-        return std::any_of(e.options.begin(), e.options.end(),
-                           [](const BackendOption& o) { return o.flag == std::string("--isa"); });
-      });
+  // --isa and --threads are options of a backend that a build may leave out
+  // (FLATMARCH_WITH_<NAME>): where no registered backend takes one, the command has no such option.
+  const auto taken = [](const std::string& flag) {
+    return flag == "--max-steps" ||
+           std::any_of(backend_registry().begin(), backend_registry().end(),
+                       [&](const BackendEntry& e) {
+                         return std::any_of(e.options.begin(), e.options.end(),
+                                            [&](const BackendOption& o) { return o.flag == flag; });
+                       });
+  };
   std::vector<ArgCase> cases;
   for (const auto& [command, args] : commands)
     for (const auto& [name, option, fragment] : options) {
       if (command == "view" && option[0] != "--max-steps") continue;  // no backend options
-      if (option[0] == "--isa" && !isa_taken) continue;
+      if (!taken(option[0])) continue;
 #ifndef FLATMARCH_WITH_VIEWER
       if (command == "view") continue;  // a build without the viewer: `view` says so, exit 3
 #endif
