@@ -128,7 +128,9 @@ class Walls {
     return edge_alike || (glue_by_lane() && glue_alike_ != 0u);
   }
   // Whether whole passes read the edges each lane holds (HeldEdges) rather than look them up:
-  // sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges.
+  // sphere and relaxed tracing in scenes of several rooms of at most kHeldEdges edges (kModeHeld),
+  // where the edges cannot be looked up in vectors unless the row holds them all the same
+  // (Tuning::held_over_lookup).
   bool held() const { return held_; }
   // Where held(): the lanes of `m` in `polygon` take their room's edges where they do not hold
   // them yet, one broadcast per number of each room taken.
