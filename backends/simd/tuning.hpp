@@ -17,7 +17,7 @@ enum class Isa { avx512, avx2, sse4 };
 // The packet code's modes: ways of running a step that a scene's shape allows and that save work
 // there, each with a fallback that gives the same frames bit for bit (simd_test's
 // EveryModeAndItsFallback runs both on every instruction set the CPU runs). What each is for,
-// where it runs and what keeps it: the table of modes below kTunings.
+// where it runs and what keeps it: the table of modes above kTunings.
 enum Mode : uint32_t {
   // Rays over several rooms take one pass a step, each lane's edges read by its room alone
   // (Rooms::whole); fallback: passes over up to rooms_per_pass rooms, each broadcast and blended.
@@ -43,7 +43,7 @@ enum Mode : uint32_t {
   kModeOppositePairs = 1u << 6,
 };
 inline constexpr uint32_t kEveryMode = (1u << 7) - 1;
-// Each mode's name (FLATMARCH_SIMD_TUNE's, simd_bench's and the tests').
+// Each mode's name (FLATMARCH_SIMD_TUNE's and the tests').
 struct ModeName {
   Mode mode;
   const char* name;
