@@ -12,6 +12,7 @@
 #include "cli/common.hpp"
 #include "cli/supervised.hpp"
 #include "conformance/suite.hpp"
+#include "conformance/vocabulary.hpp"
 #include "output/image_io.hpp"
 #include "reports/fingerprint.hpp"
 #include "reports/shard.hpp"
@@ -280,9 +281,11 @@ void add_conform(CLI::App& app) {
                      cases + 1, out["shard"]["holds"].size());
       ++cases;
       const std::string verdict = record_verdict(record);
-      failed += verdict == "fail";
-      limits += verdict == "limit";
-      const bool finished = verdict == "pass" || verdict == "limit" || verdict == "fail";
+      failed += verdict == conformance::kVerdictFail;
+      limits += verdict == conformance::kVerdictLimit;
+      const bool finished = verdict == conformance::kVerdictPass ||
+                            verdict == conformance::kVerdictLimit ||
+                            verdict == conformance::kVerdictFail;
       unfinished += !finished;
       if (o->quiet) return;
       std::fputs(

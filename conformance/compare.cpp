@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "conformance/vocabulary.hpp"
 #include "output/image_library.hpp"
 
 namespace flatmarch::conformance {
@@ -29,23 +30,9 @@ double quantile(const std::vector<float>& sorted, double q) {
 }  // namespace
 
 const char* to_string(Failure f) {
-  switch (f) {
-    case Failure::stuck:
-      return "stuck";
-    case Failure::wrong_edge:
-      return "wrong_edge";
-    case Failure::missed_object:
-      return "missed_object";
-    case Failure::phantom_hit:
-      return "phantom_hit";
-    case Failure::early_escape:
-      return "early_escape";
-    case Failure::late_escape:
-      return "late_escape";
-    case Failure::leak:
-      return "leak";
-  }
-  return "?";
+  const auto classes = failure_words();
+  const auto k = static_cast<size_t>(f);
+  return k < classes.size() ? classes[k].name : "?";
 }
 
 std::optional<int> end_code(const Event& e) {

@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "backends/scalar/scalar.hpp"
+#include "conformance/vocabulary.hpp"
+#include "scene/scene.hpp"
 
 namespace flatmarch::conformance {
 
@@ -127,50 +129,45 @@ void judge(CaseResult& r, double unpushed_ambiguous) {
 const char* to_string(Verdict v) {
   switch (v) {
     case Verdict::pass:
-      return "pass";
+      return kVerdictPass;
     case Verdict::limit:
-      return "limit";
+      return kVerdictLimit;
     case Verdict::fail:
-      return "fail";
+      return kVerdictFail;
   }
   return "?";
 }
 
-namespace {
-
-struct Swatch {
-  uint8_t r, g, b;
-  const char* colour;
-  const char* reason;
-};
-// kPixelColour, then one per failure class in compare.hpp's order.
-constexpr Swatch kSwatches[] = {
-    {255, 220, 0, "yellow", "colour beyond its region's tolerance (the ray ended as the oracle's)"},
-    {255, 0, 255, "magenta", "stuck: out of max_steps"},
-    {255, 128, 0, "orange", "wrong_edge: another path to the same kind of end"},
-    {255, 0, 0, "red", "missed_object"},
-    {0, 255, 255, "cyan", "phantom_hit"},
-    {0, 220, 0, "green", "early_escape"},
-    {80, 160, 255, "light blue", "late_escape"},
-    {255, 255, 255, "white", "leak"},
-};
-
-}  // namespace
+std::vector<uint8_t> classify_pixels(const Frame& got, const Frame& truth,
+                                     const std::vector<uint8_t>& ambiguity,
+                                     const std::vector<uint8_t>& colour_failing) {
+  std::vector<uint8_t> classes(truth.hit.size(), kPixelAgrees);
+  for (size_t px = 0; px < classes.size() && px < got.hit.size(); ++px) {
+    const auto f = classify(static_cast<int>(got.hit[px]), static_cast<int>(got.crossings[px]),
+                            static_cast<int>(truth.hit[px]), static_cast<int>(truth.crossings[px]));
+    if (px < ambiguity.size() && ambiguity[px])
+      classes[px] = kPixelAmbiguous;
+    else if (f)
+      classes[px] = static_cast<uint8_t>(kPixelFailure + static_cast<int>(*f));
+    else if (px < colour_failing.size() && colour_failing[px])
+      classes[px] = kPixelColour;
+  }
+  return classes;
+}
 
 Frame error_image(const std::vector<uint8_t>& classes, const Frame& truth) {
   Frame image(truth.width, truth.height);
-  const auto linear = [](uint8_t v) { return std::pow(static_cast<float>(v) / 255.0f, 2.2f); };
+  const auto words = pixel_class_words();
   for (size_t px = 0; px < classes.size() && px < truth.hit.size(); ++px) {
     float* out = &image.rgb[3 * px];
     if (classes[px] == kPixelAgrees) {
       const float luma = 0.2126f * truth.rgb[3 * px] + 0.7152f * truth.rgb[3 * px + 1] +
                          0.0722f * truth.rgb[3 * px + 2];
       out[0] = out[1] = out[2] = 0.01f + 0.3f * std::clamp(luma, 0.0f, 1.0f);
-    } else if (classes[px] == kPixelAmbiguous) {
-      out[0] = linear(30), out[1] = linear(40), out[2] = linear(110);
     } else {
-      const Swatch& w = kSwatches[std::min<size_t>(classes[px] - kPixelColour, 7)];
-      out[0] = linear(w.r), out[1] = linear(w.g), out[2] = linear(w.b);
+      const PixelClassWord& w = words[std::min<size_t>(classes[px], words.size() - 1)];
+      for (size_t c = 0; c < 3; ++c)
+        out[c] = static_cast<float>(decode_srgb(static_cast<double>(w.srgb[c]) / 255.0));
     }
     image.hit[px] = static_cast<float>(classes[px]);
   }
@@ -178,10 +175,9 @@ Frame error_image(const std::vector<uint8_t>& classes, const Frame& truth) {
 }
 
 std::string error_legend() {
-  std::string s =
-      "grey: agrees with the oracle (its colour, dimmed); dark blue: ambiguous "
-      "(left out)";
-  for (const Swatch& w : kSwatches) s += std::string("; ") + w.colour + ": " + w.reason;
+  std::string s;
+  for (const PixelClassWord& w : pixel_class_words())
+    s += std::string(s.empty() ? "" : "; ") + w.colour + ": " + w.name + " (" + w.meaning + ")";
   return s;
 }
 
@@ -326,22 +322,8 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
     add_check(r, "colour." + name, 100.0 * static_cast<double>(region.failed) / n,
               std::max(t.colour.failpercent, 100.0 * t.colour.allowed / n), false);
   }
-  if (keep_classes_) {
-    r.pixel_classes.assign(exact.frame.hit.size(), kPixelAgrees);
-    for (size_t px = 0; px < r.pixel_classes.size(); ++px) {
-      const auto f = classify(static_cast<int>(got.hit[px]), static_cast<int>(got.crossings[px]),
-                              static_cast<int>(exact.frame.hit[px]),
-                              static_cast<int>(exact.frame.crossings[px]));
-      uint8_t c = kPixelAgrees;
-      if (exact.ambiguity[px])
-        c = kPixelAmbiguous;
-      else if (f)
-        c = static_cast<uint8_t>(kPixelFailure + static_cast<int>(*f));
-      else if (colour_failing[px])
-        c = kPixelColour;
-      r.pixel_classes[px] = c;
-    }
-  }
+  if (keep_classes_)
+    r.pixel_classes = classify_pixels(got, exact.frame, exact.ambiguity, colour_failing);
 
   const Frame& ref = reference(scene, params, width, height);
   r.steps = step_stats(got.steps);

@@ -64,6 +64,7 @@ struct CaseResult {
 
 // What a pixel of a case's error image shows: agreement, the mask's doubt, a colour beyond the
 // region's tolerance, or the failure class (compare.hpp) of its ray, kPixelFailure + the class.
+// Each has its name, meaning and colour in vocabulary.hpp (pixel_class_words(), in this order).
 enum PixelClass : uint8_t {
   kPixelAgrees = 0,
   kPixelAmbiguous = 1,
@@ -71,11 +72,18 @@ enum PixelClass : uint8_t {
   kPixelFailure = 3
 };
 
+// The class of each pixel of `got` against the oracle's frame `truth`, row-major: ambiguous where
+// `ambiguity` says, else the failure class of its ray, else colour where `colour_failing` says
+// (compare_regions), else agrees.
+std::vector<uint8_t> classify_pixels(const Frame& got, const Frame& truth,
+                                     const std::vector<uint8_t>& ambiguity,
+                                     const std::vector<uint8_t>& colour_failing);
+
 // The error image of a case from its pixel classes and the oracle's frame: the oracle's colour,
-// dimmed to grey, where the pixel agrees; dark blue where it is ambiguous; a loud colour per
-// reason elsewhere (error_legend()). Its hit channel holds the pixel's class.
+// dimmed to grey, where the pixel agrees; elsewhere its class's colour (pixel_class_words()).
+// Its hit channel holds the pixel's class.
 Frame error_image(const std::vector<uint8_t>& classes, const Frame& truth);
-// The colours of error_image, one line per reason: "magenta: stuck (...)".
+// The colours of error_image in words, one per class: "magenta: stuck (...)".
 std::string error_legend();
 
 // Nearly horizontal rays from random points of random rooms (a fixed seed), kept when their exact

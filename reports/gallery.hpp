@@ -19,17 +19,12 @@ struct GalleryOptions {
   std::filesystem::path images;  // writes images/recommended/SCENE.png and SCENE.diff.png
 };
 
-// The difference map's pixel classes, each with its colour (sRGB, "#rrggbb") and meaning:
-// "agree" (the oracle's image, dimmed), "ambiguous" (the ambiguity mask at the default eps and
-// offset leaves it undecided, as the sweep judges), "colour" (hit and crossings agree, a
-// channel differs by more than the image check's 0.05), then the failure classes of
-// conformance/compare.hpp that a frame can show.
-nlohmann::json difference_legend();
-
-// Renders the gallery for `recommendation` (recommend()'s answer). Returns {"backend",
-// "method", "size", "legend", "scenes": [{scene, surface_type, eps, offset, image, diff (paths
-// relative to images), pixels, counts per legend class}, or {scene, error}]}; null when there is
-// no recommendation.
+// Renders the gallery for `recommendation` (recommend()'s answer): each scene's image and its
+// difference map, a conformance case's error image (the pixel classes of
+// conformance/vocabulary.hpp, masked at the default eps and offset as the sweep judges).
+// Returns {"backend", "method", "size", "scenes": [{scene, surface_type, eps, offset, image,
+// diff (paths relative to images), pixels, counts per pixel class}, or {scene, error}]}; null
+// when there is no recommendation.
 nlohmann::json recommended_gallery(const std::vector<Scene>& scenes,
                                    const nlohmann::json& recommendation,
                                    const GalleryOptions& options);

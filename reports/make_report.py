@@ -34,79 +34,47 @@ METHOD_MARKERS = {}
 PALETTE = ["#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"]
 MARKERS = ["o", "s", "^", "D", "v", "P"]
 SURFACE_TYPES = []
-# Failure classes (conformance/compare.hpp), in its order, with what each means.
-FAILURE_MEANINGS = {
-    "stuck": "ran out of steps (max_steps) where the oracle's ray ended",
-    "wrong_edge": "crossed another edge than the oracle's ray (at corners), or another number of edges",
-    "missed_object": "the oracle's ray hit an object; this one did not, or hit another",
-    "phantom_hit": "hit an object the oracle's ray did not",
-    "early_escape": "escaped (or ran out of distance) where the oracle's ray met a wall or the floor",
-    "late_escape": "met a wall or the floor where the oracle's ray escaped",
-    "leak": "a push after a crossing landed outside the destination room (probe-ray traces only)",
-}
-FAILURES = list(FAILURE_MEANINGS)
-# The conformance checks (conformance/suite.cpp), each with what it measures and over what.
-CHECKS = {
-    "hit_rate": "decided pixels whose hit (what ended the ray) is the oracle's, of the decided pixels",
-    "crossings_rate": "decided pixels whose number of crossings is the oracle's, of the decided pixels",
-    "ambiguous": "pixels the ambiguity mask leaves undecided, of all the frame's pixels",
-    "t.exceeded": "decided pixels ending as the oracle's whose path length t is off by more than the "
-                  "method's slack, of those compared",
-    "most_steps": "the most steps any ray of the frame took",
-    "image.failpercent": "% of the frame's pixels whose colour differs from the oracle's by more than 0.05 in "
-                         "a channel (undecided pixels left out)",
-    "image.max_error": "the largest difference of a colour channel over the decided pixels",
-    "image.perceptual_failpercent": "% of the frame's pixels Yee's perceptual metric tells apart from the "
-                                    "oracle's (undecided pixels left out)",
-    "steps.ks": "Kolmogorov-Smirnov distance between the frame's step counts and the scalar float64 "
-                "reference's",
-    "steps.mean_ratio": "mean steps against the scalar float64 reference's (the larger of the ratio and its "
-                        "inverse)",
-    "traces.diverged": "probe rays whose list of events differs from the oracle's, a count",
-    "traces.error": "the largest position or t error over the probe rays' agreeing events, over the "
-                    "scene's scale",
-}
-CHECKS.update({f"failures.{f}": f"decided pixels that {m}, of the decided pixels"
-               for f, m in FAILURE_MEANINGS.items() if f != "leak"})
-# Checks named per region of the frame ("colour.object 0", "colour.walls"), by their prefix.
-CHECK_PREFIXES = {
-    "colour.": "% of the region's compared pixels (an object, a vertex marker, the walls, the floor or the sky; "
-               "decided pixels whose ray ended as the oracle's) whose colour differs from the oracle's at that "
-               "pixel and at its neighbours of the region by more than the CIE Delta E tolerance",
-}
-# The short code each cause of an unstable sweep point gets in its heatmap cell.
-CAUSE_CODES = {
-    "stuck": "st", "wrong_edge": "we", "missed_object": "mo", "phantom_hit": "ph", "early_escape": "ee",
-    "late_escape": "le", "leak": "lk", "hit_rate": "hr", "crossings_rate": "cr", "ambiguous": "am",
-    "t.exceeded": "t", "most_steps": "ms", "image.failpercent": "im", "image.max_error": "mx",
-    "image.perceptual_failpercent": "pe", "steps.ks": "ks", "steps.mean_ratio": "sr",
-    "traces.diverged": "tr", "traces.error": "te", "error": "err",
-    "confirmation": "rc",
-}
-CAUSE_MEANINGS = dict(FAILURE_MEANINGS, **CHECKS, error="the backend failed to render",
-                      confirmation="passes at the sweep's size but fails its re-check at the larger size")
-# Issue 22's goals for the ambiguous share at default parameters, per method, in prisms and elsewhere
-# (None: no goal).
-AMBIGUITY_GOALS = {"analytic": {"prism": 0.05, "other": 0.05},
-                   "sphere": {"prism": None, "other": 0.12}, "relaxed": {"prism": None, "other": 0.12}}
-# A case's verdict (conformance/suite.hpp), and what it means.
-VERDICTS = {
-    "pass": "every check within its threshold",
-    "limit": "fails the thresholds only through a documented failure mode of its method (rays out of "
-             "max_steps, offset <= eps), by no more than that mode accounts for: never counted as a pass; "
-             "ctest expects it and the regression gate holds it from getting worse",
-    "fail": "beyond a threshold in any other way",
-    "error": "the backend could not render or time the case",
-    "crash": "its worker process died while it ran (a signal, or an exit part way): the run went on in a "
-             "fresh worker",
-    "timeout": "it overran its deadline (the cost model's time times --deadline-scale, at least "
-               "--deadline-floor seconds) and its worker was ended",
-    "out_of_memory": "it ran out of the worker's address-space limit (--worker-memory)",
-}
-# The verdicts of a supervised run's cases that did not finish (reports/supervise.hpp): shown only
-# where a case has one, and counted with fail and error as bad.
-UNFINISHED = ("crash", "timeout", "out_of_memory")
-BAD = ("fail", "error") + UNFINISHED
+# The suite's words (conformance/vocabulary.hpp), read from the results' "vocabulary"
+# (use_vocabulary), never restated here: the pixel and failure classes with their colours, the
+# checks, the other causes of an unstable sweep point, the verdicts and the ambiguity goals.
+VOCABULARY = {}
+FAILURE_MEANINGS = {}  # failure class -> what it means, in compare.hpp's order
+FAILURES = []
+CHECKS = {}  # check -> what it measures
+CHECK_PREFIXES = {}  # checks named per region of the frame ("colour.object 0"), by their prefix
+CAUSE_CODES = {}  # the short code each cause of an unstable sweep point gets in its heatmap cell
+CAUSE_MEANINGS = {}
+VERDICTS = {}  # a case's verdict -> what it means
+UNFINISHED = ()  # the verdicts of a supervised run's cases that did not finish
+BAD = ()  # counted against a backend: fail, error and the unfinished
+
+
+def use_vocabulary(all_results):
+    """Takes the suite's words from the first results that carry them."""
+    vocabulary = next((r["vocabulary"] for r in all_results if "vocabulary" in r), None)
+    if vocabulary is None:
+        sys.exit("make_report.py: none of the results files has a \"vocabulary\": they were written "
+                 "by an older flatmarch; run the report again")
+    global UNFINISHED, BAD
+    VOCABULARY.clear()
+    VOCABULARY.update(vocabulary)
+    failures = [c for c in vocabulary["pixel_classes"] if c["failure"]]
+    FAILURE_MEANINGS.clear()
+    FAILURE_MEANINGS.update({c["name"]: c["meaning"] for c in failures})
+    FAILURES[:] = list(FAILURE_MEANINGS)
+    CHECKS.clear()
+    CHECKS.update({c["name"]: c["meaning"] for c in vocabulary["checks"]})
+    CHECK_PREFIXES.clear()
+    CHECK_PREFIXES.update({c["prefix"]: c["meaning"] for c in vocabulary["check_prefixes"]})
+    causes = failures + vocabulary["checks"] + vocabulary["other_causes"]
+    CAUSE_CODES.clear()
+    CAUSE_CODES.update({c["name"]: c["code"] for c in causes if c["code"]})
+    CAUSE_MEANINGS.clear()
+    CAUSE_MEANINGS.update({c["name"]: c["meaning"] for c in causes})
+    VERDICTS.clear()
+    VERDICTS.update({v["name"]: v["meaning"] for v in vocabulary["verdicts"]})
+    UNFINISHED = tuple(v["name"] for v in vocabulary["verdicts"] if v["unfinished"])
+    BAD = tuple(v["name"] for v in vocabulary["verdicts"] if v["bad"])
 
 
 def use_registry(all_results):
@@ -329,7 +297,7 @@ def ambiguity_section(cases):
                 continue
             first_backends.add(got[0][0])
             others = [f"{b} {pct(v)}" for b, v in got[1:] if abs(v - got[0][1]) > 1e-9]
-            goal = AMBIGUITY_GOALS.get(m, {}).get("prism" if types[s] == "prism" else "other")
+            goal = VOCABULARY["ambiguity_goals"].get(m, {}).get("prism" if types[s] == "prism" else "other")
             cls = "warn" if goal is not None and got[0][1] > goal else ""
             row.append(td(pct(got[0][1]) + (f" (other: {', '.join(others)})" if others else ""), cls))
         rows.append(row)
@@ -555,8 +523,10 @@ def recommended_gallery_section(results, images):
                if not results.get("recommendation", {}).get("backend") else "these results have no gallery")
         return f"<h2 id=recommended>The recommended choice, scene by scene</h2><p>No images: {esc(why)}.</p>"
     legend = "<ul class=legend>" + "".join(
-        f'<li><span class="swatch" style="background:{esc(e["colour"])}"></span><b>{esc(e["class"])}</b>: '
-        f'{esc(e["meaning"])}</li>' for e in g["legend"] if e["class"] != "agree") + "</ul>"
+        f'<li><span class="swatch" style="background:{esc(e["colour"])}"></span><b>{esc(e["name"])}</b>: '
+        f'{esc(e["meaning"])}</li>' for e in VOCABULARY["pixel_classes"]
+        if e["name"] != "agree" and not e["traces_only"]) + "</ul>"
+    colour_name = {e["name"]: e["colour_name"] for e in VOCABULARY["pixel_classes"]}
     rows = []
     for sc in g["scenes"]:
         oracle = image_html(os.path.join(images, "oracle", sc["scene"] + ".png"), f'{sc["scene"]}, oracle')
@@ -580,8 +550,9 @@ def recommended_gallery_section(results, images):
             f'<b>{esc(g["method"])}</b> method ({esc(g["size"])}) at the eps and offset recommended for its surface '
             "type, beside the oracle's image and a map of where the two differ. In the map, pixels that agree "
             "show the oracle's image dimmed; a ray whose hit or crossings differ from the oracle's is painted by "
-            "its failure class, one whose hit and crossings agree but whose colour differs in yellow, and a pixel "
-            "the ambiguity mask leaves undecided in blue:</p>" + legend
+            "its failure class, one whose hit and crossings agree but whose colour differs in "
+            f'{esc(colour_name["colour"])}, and a pixel the ambiguity mask leaves undecided in '
+            f'{esc(colour_name["ambiguous"])}:</p>' + legend
             + table(["scene", "oracle", f'{g["backend"]}, {g["method"]}', "difference", "parameters and pixels"],
                     rows, "gallery recommended"))
 
@@ -1237,6 +1208,7 @@ def main():
         parser.error("--previous compares one run with an earlier one: give one results file")
     os.makedirs(args.out, exist_ok=True)
     use_registry(all_results)
+    use_vocabulary(all_results)
     if len(all_results) == 1:
         images = os.path.join(os.path.dirname(os.path.abspath(args.results[0])), "images")
         page = one_machine(all_results[0], images, previous, args.previous)

@@ -9,6 +9,7 @@
 #include <optional>
 #include <set>
 
+#include "conformance/vocabulary.hpp"
 #include "reports/fingerprint.hpp"
 #include "reports/gallery.hpp"
 #include "reports/shard.hpp"
@@ -96,6 +97,7 @@ json report_header(const std::vector<Scene>& scenes, const ReportOptions& o) {
                          {"methods", methods},
                          {"surface_types", surface_types()},
                          {"fingerprint_rows", machine}};
+  results["vocabulary"] = conformance::vocabulary_json();
   results["options"] = {
       {"size", std::to_string(o.matrix.width) + "x" + std::to_string(o.matrix.height)},
       {"conform_size",
@@ -166,7 +168,7 @@ json run_report_part(const std::vector<Scene>& scenes, const ReportOptions& o,
 json unfinished_entry(const std::string& key, const json& record) {
   json entry = {{"key", key},
                 {"stage", key.substr(0, key.find('/'))},
-                {"verdict", record.value("verdict", "error")},
+                {"verdict", record.value("verdict", conformance::kVerdictError)},
                 {"error", unfinished_summary(record)}};
   for (const char* field :
        {"seconds", "signal_name", "exit_code", "deadline_seconds", "stderr_tail", "signal"})
@@ -193,7 +195,7 @@ json unfinished_part(const std::string& key, const json& record, const std::vect
                 {"method", method},
                 {"width", o.matrix.width},
                 {"height", o.matrix.height},
-                {"verdict", record.value("verdict", "error")},
+                {"verdict", record.value("verdict", conformance::kVerdictError)},
                 {"error", unfinished_summary(record)}};
   return {{"matrix", {{"cases", json::array({entry})}}}};
 }
@@ -294,12 +296,13 @@ json rank_backends(const json& matrix) {
     }
     // A case at its method's limit (issue 22) is no pass: counted apart.
     const std::string verdict =
-        c.contains("accuracy")
-            ? c["accuracy"].value("verdict", c["accuracy"]["passed"].get<bool>() ? "pass" : "fail")
-            : "pass";
-    const bool passed = verdict == "pass";
+        c.contains("accuracy") ? c["accuracy"].value("verdict", c["accuracy"]["passed"].get<bool>()
+                                                                    ? conformance::kVerdictPass
+                                                                    : conformance::kVerdictFail)
+                               : conformance::kVerdictPass;
+    const bool passed = verdict == conformance::kVerdictPass;
     t.passed += passed;
-    t.limits += verdict == "limit";
+    t.limits += verdict == conformance::kVerdictLimit;
     m[1] += passed;
     if (c.contains("counters") && c["counters"].value("rays_per_s", 0.0) > 0.0) {
       const double l = std::log(c["counters"]["rays_per_s"].get<double>());
@@ -639,7 +642,8 @@ json check_baseline(const json& baseline, const json& results) {
       // A case that crashed, overran its deadline or ran out of memory (a supervised run's
       // verdicts), or that could not run: a regression of a case that ran before.
       const std::string was =
-          figures.value("verdict", figures.value("passed", false) ? "pass" : "fail");
+          figures.value("verdict", figures.value("passed", false) ? conformance::kVerdictPass
+                                                                  : conformance::kVerdictFail);
       if (c.contains("verdict"))
         out["regressions"].push_back({{"case", name},
                                       {"figure", "verdict"},
@@ -660,12 +664,12 @@ json check_baseline(const json& baseline, const json& results) {
                                     {"now", false},
                                     {"failed_checks", c["accuracy"]["failed_checks"]}});
     // A case at its method's limit that now fails outright is a regression too.
-    if (figures.value("verdict", "") == "limit" && c.contains("accuracy") &&
-        c["accuracy"].value("verdict", "") == "fail")
+    if (figures.value("verdict", "") == conformance::kVerdictLimit && c.contains("accuracy") &&
+        c["accuracy"].value("verdict", "") == conformance::kVerdictFail)
       out["regressions"].push_back({{"case", name},
                                     {"figure", "verdict"},
-                                    {"was", "limit"},
-                                    {"now", "fail"},
+                                    {"was", conformance::kVerdictLimit},
+                                    {"now", conformance::kVerdictFail},
                                     {"failed_checks", c["accuracy"]["failed_checks"]}});
     for (const Figure& f : kFigures) {
       if (!figures.contains(f.name) || !c.contains(f.source) || !c[f.source].contains(f.name))
@@ -864,6 +868,7 @@ json merge_report(const std::vector<std::pair<std::string, json>>& files) {
   json out = merged_header(files);
   out["created"] = now_utc();
   out["registry"] = first["registry"];
+  out["vocabulary"] = first.value("vocabulary", conformance::vocabulary_json());
   out.update(assemble_report(first, parts, keys));
   out["shards"] = per_shard;
   out["unfinished"] = unfinished;

@@ -58,7 +58,7 @@ nlohmann::json run_report(const std::vector<Scene>& scenes, const ReportOptions&
                           const ReportProgress& progress);
 
 // The results' header: "format", "created", "fingerprint", "registry" (the lists make_report.py
-// draws by) and "options".
+// draws by), "vocabulary" (the suite's words, conformance/vocabulary.hpp) and "options".
 nlohmann::json report_header(const std::vector<Scene>& scenes, const ReportOptions& options);
 
 // The conformance suites of a report's stages: the sweep fixes its suite's mask (one truth for

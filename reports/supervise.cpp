@@ -296,7 +296,7 @@ int StopSignals::stop_requested() {
 }
 
 bool is_supervision_verdict(const std::string& verdict) {
-  return verdict == kVerdictCrash || verdict == kVerdictTimeout || verdict == kVerdictOutOfMemory;
+  return conformance::is_unfinished_verdict(verdict);
 }
 
 double case_deadline(double cost_seconds, double scale, double floor_seconds) {

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "conformance/vocabulary.hpp"
+
 namespace flatmarch::reports {
 
 // A run stopped by SIGINT or SIGTERM (`signal`) while StopSignals was in place: the case under
@@ -43,10 +45,11 @@ class StopSignals {
   struct sigaction old_[2] = {};  // SIGINT's and SIGTERM's handlers before
 };
 
-// The verdicts of a supervised case beside pass, limit and fail.
-inline constexpr const char* kVerdictCrash = "crash";
-inline constexpr const char* kVerdictTimeout = "timeout";
-inline constexpr const char* kVerdictOutOfMemory = "out_of_memory";
+// The verdicts of a supervised case beside pass, limit and fail: conformance/vocabulary.hpp's
+// kVerdictCrash, kVerdictTimeout and kVerdictOutOfMemory (its unfinished ones).
+using conformance::kVerdictCrash;
+using conformance::kVerdictOutOfMemory;
+using conformance::kVerdictTimeout;
 // Whether `verdict` is one of them.
 bool is_supervision_verdict(const std::string& verdict);
 

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "conformance/vocabulary.hpp"
 #include "reports/matrix.hpp"
 #include "reports/shard.hpp"
 #include "scene/surfaces.hpp"
@@ -38,7 +39,7 @@ double median(std::vector<double> v) {
 // A point is stable on a scene when the conformance verdict there is `pass` (issue 22): a
 // `limit` of the method is no pass, and no check is left out.
 bool stable_point(const json& accuracy) {
-  return accuracy["verdict"] == "pass";
+  return accuracy["verdict"] == conformance::kVerdictPass;
 }
 
 const std::string kFailurePrefix = "failures.";
@@ -211,9 +212,9 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
           const json a = accuracy_summary(suite.run(*backend, scene, params, cw, ch));
           verdict = {{"verdict", a["verdict"]}, {"failed", a["failed"]}};
         } catch (const std::exception& e) {
-          verdict = {{"verdict", "error"}, {"error", e.what()}};
+          verdict = {{"verdict", conformance::kVerdictError}, {"error", e.what()}};
         }
-        k["passed"] = k["passed"].get<bool>() && verdict["verdict"] == "pass";
+        k["passed"] = k["passed"].get<bool>() && verdict["verdict"] == conformance::kVerdictPass;
         k["scenes"][scene.name] = verdict;
       }
       if (progress)
@@ -370,7 +371,7 @@ json analyse_sweep(const json& points, const json& confirmations) {
     }
     const json& a = p["accuracy"];
     c.passed += stable_point(a);
-    c.limits += a["verdict"] == "limit";
+    c.limits += a["verdict"] == conformance::kVerdictLimit;
     for (const json& check : a["failed"]) ++c.failed_checks[check.get<std::string>()];
     for (const auto& [failure, n] : a["failures"].items()) c.failure_rays[failure] += n.get<long>();
     c.time_ms += p["time_ms"].get<double>();

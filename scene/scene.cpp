@@ -58,11 +58,14 @@ const std::vector<const char*>& gluing_palette() {
 Vec3 linear_from_hex(const char* hex) {
   const unsigned long rgb = std::strtoul(hex + 1, nullptr, 16);
   Vec3 c;
-  for (int i = 0; i < 3; ++i) {
-    const double v = static_cast<double>((rgb >> (8 * (2 - i))) & 0xffu) / 255.0;
-    c[i] = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-  }
+  for (int i = 0; i < 3; ++i)
+    c[i] = decode_srgb(static_cast<double>((rgb >> (8 * (2 - i))) & 0xffu) / 255.0);
   return c;
+}
+
+double decode_srgb(double encoded) {
+  const double v = std::clamp(encoded, 0.0, 1.0);
+  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
 }
 
 double encode_srgb(double linear) {

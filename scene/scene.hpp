@@ -199,6 +199,8 @@ struct Look {
 const std::vector<const char*>& gluing_palette();
 // A linear value in [0, 1] encoded to sRGB (IEC 61966-2-1; clamped).
 double encode_srgb(double linear);
+// An sRGB value in [0, 1] decoded to linear (clamped).
+double decode_srgb(double encoded);
 // An sRGB "#rrggbb" colour as linear RGB, and back (rounded to 8 bits).
 Vec3 linear_from_hex(const char* hex);
 std::string hex_from_linear(Vec3 c);

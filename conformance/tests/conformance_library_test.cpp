@@ -3,11 +3,14 @@
 // backend broken on purpose.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "backends/scalar/scalar.hpp"
 #include "conformance/suite.hpp"
+#include "conformance/vocabulary.hpp"
 #include "output/image_io.hpp"
 #include "scene/load.hpp"
 #include "tests/process.hpp"
@@ -309,6 +312,81 @@ TEST(Suite, TheScalarBackendPassesAndEachFlawIsCaughtByItsCheck) {
       EXPECT_EQ(suite.run(Broken(f), scene, params, 64, 36).verdict, Verdict::fail)
           << to_string(m) << " flaw " << static_cast<int>(f);
   }
+}
+
+// The suite's words (vocabulary.hpp): every check a case has, every failure class and every
+// verdict the code can give is one of them, with a meaning.
+TEST(Vocabulary, NamesEveryCheckFailureClassAndVerdict) {
+  const Scene scene = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
+                                            "radius": 0.5}], "camera": {"position": [0.5, 0.7, 1],
+                                            "yaw_deg": 20})");
+  Suite suite;
+  const CaseResult r =
+      suite.run(Broken(Broken::Flaw::phantom_object), scene, MarchParams{}, 32, 18);
+  ASSERT_GT(r.checks.size(), 20u);
+  for (const Check& c : r.checks) {
+    const char* meaning = check_meaning(c.name);
+    EXPECT_TRUE(meaning && *meaning) << c.name;
+  }
+  EXPECT_EQ(check_meaning("no_such_check"), nullptr);
+  // A region's check by its prefix.
+  EXPECT_STREQ(check_meaning("colour.object_0"), check_prefix_words()[0].meaning);
+
+  ASSERT_EQ(failure_words().size(), static_cast<size_t>(kFailureClasses));
+  for (int f = 0; f < kFailureClasses; ++f)
+    EXPECT_STREQ(to_string(static_cast<Failure>(f)), failure_words()[static_cast<size_t>(f)].name);
+  EXPECT_STREQ(to_string(Failure::phantom_hit), "phantom_hit");
+  EXPECT_STREQ(pixel_class_words()[kPixelFailure + static_cast<int>(Failure::stuck)].name, "stuck");
+
+  for (const Verdict v : {Verdict::pass, Verdict::limit, Verdict::fail}) {
+    const std::string name = to_string(v);
+    EXPECT_TRUE(std::any_of(verdict_words().begin(), verdict_words().end(),
+                            [&](const VerdictWord& w) { return name == w.name; }))
+        << name;
+  }
+  EXPECT_FALSE(is_bad_verdict("pass"));
+  EXPECT_FALSE(is_bad_verdict("limit"));
+  EXPECT_TRUE(is_bad_verdict("fail"));
+  EXPECT_TRUE(is_bad_verdict("error"));
+  EXPECT_TRUE(is_unfinished_verdict("timeout"));
+  EXPECT_FALSE(is_unfinished_verdict("fail"));
+  EXPECT_FALSE(is_bad_verdict("no_such_verdict"));
+
+  // In results.json: each class's colour as "#rrggbb", each name once.
+  const nlohmann::json v = vocabulary_json();
+  ASSERT_EQ(v["pixel_classes"].size(), pixel_class_words().size());
+  std::set<std::string> names;
+  for (const nlohmann::json& c : v["pixel_classes"]) EXPECT_TRUE(names.insert(c["name"]).second);
+  EXPECT_EQ(v["pixel_classes"][kPixelFailure + static_cast<int>(Failure::missed_object)]["colour"],
+            "#ff0000");
+  EXPECT_EQ(v["ambiguity_goals"]["analytic"]["other"], 0.05);
+  EXPECT_TRUE(v["ambiguity_goals"]["sphere"]["prism"].is_null());
+}
+
+// An error image paints each class its colour, decoded from sRGB exactly (IEC 61966-2-1), and
+// the agreeing pixels the oracle's image dimmed to grey.
+TEST(Vocabulary, ErrorImagesPaintEachClassItsColour) {
+  Frame truth(4, 1);
+  for (size_t px = 0; px < 4; ++px) truth.set(px, 1.0f, 1.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+  const std::vector<uint8_t> classes = {kPixelAgrees, kPixelColour,
+                                        kPixelFailure + static_cast<int>(Failure::stuck),
+                                        kPixelFailure + static_cast<int>(Failure::missed_object)};
+  const Frame image = error_image(classes, truth);
+  EXPECT_NEAR(image.rgb[0], 0.31f, 1e-5f);  // 0.01 + 0.3 of a white pixel's luminance
+  // Yellow, (255, 220, 0): 220 decodes to ((220 / 255 + 0.055) / 1.055)^2.4 = 0.71569.
+  EXPECT_NEAR(image.rgb[3], 1.0f, 1e-6f);
+  EXPECT_NEAR(image.rgb[4], 0.71569f, 1e-4f);
+  EXPECT_NEAR(image.rgb[5], 0.0f, 1e-6f);
+  // Magenta and red.
+  EXPECT_NEAR(image.rgb[6], 1.0f, 1e-6f);
+  EXPECT_NEAR(image.rgb[7], 0.0f, 1e-6f);
+  EXPECT_NEAR(image.rgb[8], 1.0f, 1e-6f);
+  EXPECT_NEAR(image.rgb[9], 1.0f, 1e-6f);
+  EXPECT_NEAR(image.rgb[10], 0.0f, 1e-6f);
+  EXPECT_EQ(image.hit[2], static_cast<float>(classes[2]));
+  // The legend in words names each class by its colour.
+  EXPECT_NE(error_legend().find("magenta: stuck"), std::string::npos) << error_legend();
+  EXPECT_NE(error_legend().find("cyan: phantom_hit"), std::string::npos) << error_legend();
 }
 
 TEST(CliConform, SphereTracingAPrismIsAtItsLimitNotAPass) {

@@ -130,6 +130,11 @@ def main():
     for scene in results["options"]["scenes"]:
         for alt in (f"{scene}, oracle", f'{scene}, {rec["backend"]} {rec["method"]}', f"{scene}, difference"):
             expect(f'alt="{alt}"' in gallery, f"recommended gallery: no image {alt!r}")
+    # The map's legend in the one palette the results carry (conformance/vocabulary.hpp).
+    for c in results["vocabulary"]["pixel_classes"]:
+        if c["name"] != "agree" and not c["traces_only"]:
+            expect(f'background:{c["colour"]}' in gallery.replace(" ", ""),
+                   f'recommended gallery: no {c["colour"]} swatch for {c["name"]}')
 
     for anchor in ("ambiguity", "definitions", "sweep"):
         expect(section(dom, anchor), f"no {anchor} section")
