@@ -195,7 +195,7 @@ struct BackendEntry {
   BackendCost cost{};
   // The conformance tests run its cases in one process with the other backends of this batch
   // (tests/CMakeLists.txt's BATCH, made from each backend's flatmarch_add_backend): "kernels",
-  // whose cases share each scene's truth, or one of its own ("webgl": it starts a browser).
+  // whose cases share each scene's truth, or one of its own (a backend that starts a browser).
   std::string test_batch = "kernels";
   // A CPU backend that runs the kernel, by speed (0: not one): the fastest built and available is
   // `render`'s default and the report's quick sweep's; the slowest, the reference, its fallback.

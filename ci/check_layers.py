@@ -37,8 +37,9 @@ LAYERS = [
     "cli",  # the `flatmarch` program
 ]
 TEST_FOLDERS = {"tests", "bench", "fuzz"}
-# Backends whose folders code above backends/ may include, and by whom ("*": everyone).
-BACKEND_USERS = {"oracle": {"*"}, "scalar": {"*"}, "opengl": {"viewer"}}
+# Backends whose folders code above backends/ may include, by folder, and by whom ("*":
+# everyone): the viewer draws its window with the OpenGL backend's kernel.
+BACKEND_USERS = {"backends/oracle": {"*"}, "backends/scalar": {"*"}, "backends/opengl": {"viewer"}}
 SOURCE = re.compile(r"\.(cpp|hpp|h|inc|in)$")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
@@ -94,7 +95,7 @@ def main() -> int:
                     if mine is not None:
                         broken.append(f"{where}: one backend's folder includes another's")
                     continue
-                users = BACKEND_USERS.get(backend, set())
+                users = BACKEND_USERS.get(f"backends/{backend}", set())
                 if "*" not in users and here not in users:
                     broken.append(f"{where}: only {sorted(users) or 'test code'} may use the "
                                   f"{backend} backend's folder (BACKEND_USERS)")

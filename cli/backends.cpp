@@ -28,6 +28,7 @@ void add_backends(CLI::App& app) {
                       {"methods", methods},
                       {"description", b->description()},
                       {"kernel", registry[k].kernel},
+                      {"cpu", registry[k].cpu_rank > 0},
                       {"reference_for", registry[k].reference_for}});
       if (const auto device = b->device())
         list.back()["device"] = {{"name", device->name},         {"type", device->type},

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "backends/backend.hpp"
 #include "backends/oracle/oracle.hpp"
 #include "backends/scalar/scalar.hpp"
 #include "conformance/compare.hpp"
@@ -41,19 +42,13 @@ test::ProcessResult flatmarch(const std::vector<std::string>& args, const std::s
 }
 
 // A small report: two backends, two methods, scenes of three surface types, the sweep.
+// A small report on every CPU backend of the kernel this build has.
 std::vector<std::string> small_report(const fs::path& out) {
-  std::vector<std::string> args = {"report",     "-o",
-                                   out.string(), "--backend",
-                                   "scalar",     "--backend",
-                                   "simd",       "--method",
-                                   "analytic",   "--method",
-                                   "sphere",     "--size",
-                                   "32x18",      "--conform-size",
-                                   "32x18",      "--repetitions",
-                                   "2",          "--min-time",
-                                   "0.001",      "--sweep-size",
-                                   "16x9",       "--no-scaling",
-                                   "-q"};
+  std::vector<std::string> args = {"report", "-o", out.string()};
+  for (const std::string& b : cpu_backend_names()) args.insert(args.end(), {"--backend", b});
+  args.insert(args.end(), {"--method", "analytic", "--method", "sphere", "--size", "32x18",
+                           "--conform-size", "32x18", "--repetitions", "2", "--min-time", "0.001",
+                           "--sweep-size", "16x9", "--no-scaling", "-q"});
   for (const char* s : {"torus", "l_shape", "mirror_pentagon"})
     args.insert(args.end(),
                 {"--scene", std::string(FLATMARCH_SOURCE_DIR) + "/scenes/" + s + ".json"});

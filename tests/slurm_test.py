@@ -139,8 +139,12 @@ def main():
             scenes += ["--scene", s]
         conform = ["--backend", "scalar", "--method", "sphere", "--method", "analytic",
                    "--size", "48x27", *gallery, *scenes]
-        # The main job, small: the matrix and the sweep (its re-checks and recommendation too).
-        report = ["--backend", "scalar", "--backend", "simd", "--method", "sphere", "--method",
+        # The main job, small: the matrix and the sweep (its re-checks and recommendation too), on
+        # every CPU backend of the kernel this build has.
+        listed = json.loads(subprocess.run([flatmarch, "backends", "--json"], capture_output=True,
+                                           text=True, check=True, timeout=60).stdout)
+        cpu = [a for b in listed if b["cpu"] for a in ("--backend", b["name"])]
+        report = [*cpu, "--method", "sphere", "--method",
                   "analytic", "--size", "32x18", "--conform-size", "32x18", "--sweep-size",
                   "16x9", "--repetitions", "2", "--min-time", "0.001", "--no-scaling", "-q",
                   *gallery, *scenes]

@@ -20,7 +20,7 @@ bool is_compute(const ShaderRequest& r) {
 
 BackendEntry opengl_backend_entry() {
   return {
-      .name = "opengl",
+      .name = OpenGlBackend::kName,
       .make = [](const BackendOptions& o) { return std::make_unique<OpenGlBackend>(o); },
       .options = {{"--device", &BackendOptions::device,
                    "the device, by its index or a part of its name as `flatmarch backends` "

@@ -22,7 +22,8 @@ class OpenGlBackend final : public Backend {
   explicit OpenGlBackend(const BackendOptions& options = {});
   ~OpenGlBackend() override;
 
-  std::string name() const override { return "opengl"; }
+  static constexpr const char* kName = "opengl";  // in the registry (the viewer draws with it)
+  std::string name() const override { return kName; }
   std::string description() const override;
   Availability availability() const override;
   std::vector<Method> methods() const override {

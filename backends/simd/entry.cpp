@@ -26,7 +26,7 @@ std::string version(int major, int minor, int patch) {
 
 BackendEntry simd_backend_entry() {
   return {
-      .name = "simd",
+      .name = SimdBackend::kName,
       .make = [](const BackendOptions& o) { return std::make_unique<SimdBackend>(o); },
       .variants =
           [] {

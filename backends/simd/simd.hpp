@@ -29,7 +29,8 @@ class SimdBackend final : public Backend {
   // options.isa: one of simd::isa_names (empty: the best here); options.threads: 0 for all cores.
   explicit SimdBackend(BackendOptions options = {});
 
-  std::string name() const override { return "simd"; }
+  static constexpr const char* kName = "simd";  // in the registry
+  std::string name() const override { return kName; }
   std::string description() const override;
   Availability availability() const override;
   std::vector<Method> methods() const override {

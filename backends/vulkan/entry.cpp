@@ -12,7 +12,7 @@ namespace flatmarch {
 
 BackendEntry vulkan_backend_entry() {
   return {
-      .name = "vulkan",
+      .name = VulkanBackend::kName,
       .make = [](const BackendOptions& o) { return std::make_unique<VulkanBackend>(o); },
       .options = {{"--device", &BackendOptions::device,
                    "likewise "

@@ -38,7 +38,8 @@ class VulkanBackend final : public Backend {
   explicit VulkanBackend(const BackendOptions& options = {});
   ~VulkanBackend() override;
 
-  std::string name() const override { return "vulkan"; }
+  static constexpr const char* kName = "vulkan";  // in the registry
+  std::string name() const override { return kName; }
   std::string description() const override;
   Availability availability() const override;
   std::vector<Method> methods() const override {

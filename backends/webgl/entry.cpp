@@ -5,7 +5,7 @@
 namespace flatmarch {
 
 BackendEntry webgl_backend_entry() {
-  return {.name = "webgl",
+  return {.name = WebGlBackend::kName,
           .make = [](const BackendOptions& o) { return std::make_unique<WebGlBackend>(o); },
           .options = {{"--device", &BackendOptions::device,
                        "gpu or swiftshader (default: Chromium's choice, a GPU where it can "

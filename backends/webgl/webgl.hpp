@@ -22,7 +22,8 @@ class WebGlBackend final : public Backend {
   explicit WebGlBackend(const BackendOptions& options = {});
   ~WebGlBackend() override;
 
-  std::string name() const override { return "webgl"; }
+  static constexpr const char* kName = "webgl";  // in the registry
+  std::string name() const override { return kName; }
   std::string description() const override;
   Availability availability() const override;
   std::vector<Method> methods() const override {

@@ -177,18 +177,18 @@ TEST(Thresholds, LayersApplyInOrderAndExceptionsSayWhy) {
   const nlohmann::json doc = nlohmann::json::parse(R"({
     "defaults": {"hit_rate": 0.9, "crossings_rate": 0.8},
     "methods": {"sphere": {"hit_rate": 0.8}},
-    "backends": {"simd": {"hit_rate": 0.7}},
+    "backends": {"fast": {"hit_rate": 0.7}},
     "exceptions": [{"scenes": ["torus"], "methods": ["sphere"], "why": "slow corners",
                     "set": {"failures": {"stuck": 0.5}}}]})");
   Thresholds t = thresholds_for(doc, "scalar", Method::analytic, "cube");
   EXPECT_EQ(t.hit_rate, 0.9);
   EXPECT_EQ(t.crossings_rate, 0.8);
   EXPECT_EQ(thresholds_for(doc, "scalar", Method::sphere, "cube").hit_rate, 0.8);
-  t = thresholds_for(doc, "simd", Method::sphere, "torus");
+  t = thresholds_for(doc, "fast", Method::sphere, "torus");
   EXPECT_EQ(t.hit_rate, 0.7);
   EXPECT_EQ(t.failure_max[static_cast<size_t>(Failure::stuck)], 0.5);
   EXPECT_EQ(t.why, "slow corners");
-  EXPECT_EQ(thresholds_for(doc, "simd", Method::relaxed, "torus").why, "");
+  EXPECT_EQ(thresholds_for(doc, "fast", Method::relaxed, "torus").why, "");
 }
 
 TEST(Thresholds, ABadFileNamesTheKey) {

@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/backend.hpp"
+#include "backends/opengl/opengl.hpp"
 #include "tests/gallery.hpp"
 #include "tests/process.hpp"
 #include "viewer/controls.hpp"
@@ -213,11 +214,13 @@ TEST_F(ViewerTest, ScreenshotIsTheViewAtTheWindowSize) {
     colours.insert(pixels[px] << 16 | pixels[px + 1] << 8 | pixels[px + 2]);
   EXPECT_GE(colours.size(), 50u) << "the screenshot is nearly blank";
 
-  const Backend* opengl = find_backend("opengl");
+  // The backend the window draws with.
+  const Backend* opengl = find_backend(OpenGlBackend::kName);
   if (!opengl || !opengl->availability().available) return;  // nothing to compare with here
-  const auto rendered = test::run_flatmarch(
-      {"render", scene_path("torus"), "-o", file("render.png"), "--backend", "opengl", "--method",
-       "sphere", "--size", std::to_string(kWidth) + "x" + std::to_string(kHeight), "--quiet"});
+  const auto rendered =
+      test::run_flatmarch({"render", scene_path("torus"), "-o", file("render.png"), "--backend",
+                           OpenGlBackend::kName, "--method", "sphere", "--size",
+                           std::to_string(kWidth) + "x" + std::to_string(kHeight), "--quiet"});
   ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
   OIIO::ImageBuf render(file("render.png"));
   std::vector<unsigned char> expected(pixels.size());

@@ -206,17 +206,17 @@ TEST(WebGlCli, WithoutChromiumExits3AndSaysWhy) {
   const std::string out = test::make_temp_dir() + "/x.png";
   const std::string scene = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
   auto r = test::run_process({"env", "FLATMARCH_CHROMIUM=/no/such/chromium", FLATMARCH_BINARY,
-                              "render", scene, "--backend", "webgl", "-o", out});
+                              "render", scene, "--backend", WebGlBackend::kName, "-o", out});
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("webgl is unavailable here: cannot run /no/such/chromium"),
             std::string::npos)
       << r.err;
-  r = test::run_process(
-      {"env", "PATH=/nowhere", FLATMARCH_BINARY, "render", scene, "--backend", "webgl", "-o", out});
+  r = test::run_process({"env", "PATH=/nowhere", FLATMARCH_BINARY, "render", scene, "--backend",
+                         WebGlBackend::kName, "-o", out});
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("no Chromium found"), std::string::npos) << r.err;
-  r = test::run_process({FLATMARCH_BINARY, "render", scene, "--backend", "webgl", "--device",
-                         "no such device", "-o", out});
+  r = test::run_process({FLATMARCH_BINARY, "render", scene, "--backend", WebGlBackend::kName,
+                         "--device", "no such device", "-o", out});
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("--device is one of gpu, swiftshader"), std::string::npos) << r.err;
 }
