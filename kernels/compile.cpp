@@ -182,15 +182,13 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
                                static_cast<int>(t.objects.size()) - first_object));
   }
 
-  // Where every room is convex, a step far from the walls finds its distance to them from
-  // the edges' lines alone (march.glsl's wall_distance).
-  if (convex_rooms(t))
-    for (auto& e : t.edges) e.link.w = 1;
-
   typename Tables<real>::KernelParams& k = t.params;
   k.method = kernel_method(march.method);
   k.max_steps = march.max_steps;
   k.polygon_count = static_cast<int>(scene.polygons.size());
+  // Where every room is convex, a step far from the walls finds its distance to them from
+  // the edges' lines alone (march.glsl's wall_distance).
+  k.convex = convex_rooms(t) ? 1 : 0;
   k.eps = real(march.eps);
   k.offset = real(march.offset);
   k.max_distance = real(march.max_distance);

@@ -1,6 +1,6 @@
 // The C++ side of the GLSL subset the kernel is written in (kernels/*.glsl). GLM mirrors GLSL's
 // types and functions; what differs is spelled with the macros below, which a shader's prelude
-// defines the GLSL way (`#define INOUT(T) inout T`, `#define KCONST const`).
+// defines the GLSL way (`#define INOUT(T) inout T`, `#define KCONST const`, `#define ALIGN16`).
 //
 // Rules for kernel code, so that it compiles as both: no pointers, references, templates,
 // overloading on return type, recursion or library calls; literals written as real(1.5); no
@@ -14,6 +14,9 @@
 #define INOUT(T) T&
 // A constant at file scope (GLSL `const`).
 #define KCONST inline constexpr
+// A table member that a std140 block starts at a 16-byte boundary, as GLSL aligns a vec4 there
+// by itself (kernels/tables.glsl's KernelParams).
+#define ALIGN16 alignas(16)
 // A function of kernels/maths.glsl: inline, and forced inline where maths.glsl is compiled for
 // packets of rays (backends/simd/maths-inl.h redefines it).
 #define KINLINE inline

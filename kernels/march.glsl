@@ -105,7 +105,7 @@ struct WallDistance {
 
 WallDistance wall_distance(int polygon, vec2 p) {
   ivec4 poly = polygons[room(polygon)];
-  if (edges[poly.x].link.w != 0) {
+  if (params.convex != 0) {
     // The rooms are convex: inside, the nearest edge is as near as the nearest edge's line (the
     // foot of the perpendicular to that line lies on the edge), and a point is outside where it
     // is beyond a line. No edge is nearer than its line, so the segments are measured only

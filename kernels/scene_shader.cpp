@@ -174,14 +174,14 @@ int row_stride(int rows) {
 
 std::string baked_params(const Tables<float>::KernelParams& p) {
   // In the order of KernelParams' fields (kernels/tables.glsl). The web page's eps and offset keys
-  // rewrite the fourth and fifth (web/page.js, withParams).
+  // rewrite the fifth and sixth (web/page.js, withParams).
   return "const KernelParams params = KernelParams(\n    " + std::to_string(p.method) + ", " +
-         std::to_string(p.max_steps) + ", " + std::to_string(p.polygon_count) + ",\n    " +
-         number(p.eps) + ", " + number(p.offset) + ", " + number(p.max_distance) + ", " +
-         number(p.omega) + ",\n    " + number(p.height) + ", " + number(p.top) + ", " +
-         number(p.vertex_tolerance) + ", " + number(p.normal_step) + ", " + number(p.fog_distance) +
-         ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.sky) + ", " +
-         vec4_literal(p.ground) + ", " + vec4_literal(p.wall) + ", " +
+         std::to_string(p.max_steps) + ", " + std::to_string(p.polygon_count) + ", " +
+         std::to_string(p.convex) + ",\n    " + number(p.eps) + ", " + number(p.offset) + ", " +
+         number(p.max_distance) + ", " + number(p.omega) + ",\n    " + number(p.height) + ", " +
+         number(p.top) + ", " + number(p.vertex_tolerance) + ", " + number(p.normal_step) + ", " +
+         number(p.fog_distance) + ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.sky) +
+         ", " + vec4_literal(p.ground) + ", " + vec4_literal(p.wall) + ", " +
          vec4_literal(p.floor_colour) + ", " + vec4_literal(p.period_tint) + ");\n";
 }
 

@@ -10,8 +10,7 @@ struct EdgeRecord {
   vec4 line;        // outward unit normal n (x, y), dot(n, a) (z), 1 / |b - a|^2 (w)
   vec4 map_linear;  // the gluing map's linear part, columns (x, y) and (z, w)
   vec4 map_shift;   // its translation (x, y), 0, 0
-  ivec4 link;       // kind (kEdge*), destination polygon, destination edge, and 1 where
-                    // every room of the scene is convex, else 0 (the same on every edge)
+  ivec4 link;       // kind (kEdge*), destination polygon, destination edge, 0 (unused)
   vec4 tint;        // glued or mirror: the colour (xyz) a crossing mixes in, and its opacity at
                     // normal incidence (w); a wall: 0
 };
@@ -25,11 +24,13 @@ struct ObjectRecord {
   ivec4 info;   // solid (kSolid*), index in the hit AOV, 0, 0
 };
 
-// Per-frame constants: the march parameters (DESIGN.md section 3), the band and the look.
+// Per-frame constants: the march parameters (DESIGN.md section 3), the band and the look. As a
+// std140 block the vec4s start at a 16-byte boundary after the 13 scalars; ALIGN16 says so in C++.
 struct KernelParams {
-  int method;      // kMethod*
+  int method;  // kMethod*
   int max_steps;
   int polygon_count;
+  int convex;  // 1 where every room of the scene is convex (march.glsl's wall_distance), else 0
   real eps;
   real offset;
   real max_distance;
@@ -39,7 +40,7 @@ struct KernelParams {
   real vertex_tolerance;  // analytic: an exit this close to a vertex meets the vertex
   real normal_step;       // step of the finite differences that give object normals
   real fog_distance;       // path length at which a surface is half fog
-  vec4 fog;               // the look (DESIGN.md section 1), linear RGB (xyz)
+  ALIGN16 vec4 fog;       // the look (DESIGN.md section 1), linear RGB (xyz)
   vec4 sky;
   vec4 ground;
   vec4 wall;

@@ -48,10 +48,10 @@ function stepOffset(steps) {
   offsetSteps += steps;
 }
 // A shader with other eps and offset: they are baked into its parameters' constant
-// (kernels/scene_shader.cpp, baked_params: method, max_steps, polygons, eps, offset, ...).
+// (kernels/scene_shader.cpp, baked_params: method, max_steps, polygons, convex, eps, offset, ...).
 function withParams(source, e, o) {
   const glslFloat = (x) => x.toExponential(8);
-  return source.replace(/(const KernelParams params = KernelParams\(\s*[^,]+,\s*[^,]+,\s*[^,]+,\s*)[^,]+,\s*[^,]+,/,
+  return source.replace(/(const KernelParams params = KernelParams\(\s*[^,]+,\s*[^,]+,\s*[^,]+,\s*[^,]+,\s*)[^,]+,\s*[^,]+,/,
                         (all, head) => head + glslFloat(e) + ", " + glslFloat(o) + ",");
 }
 

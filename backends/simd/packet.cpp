@@ -420,10 +420,9 @@ PacketJob packet_job(const kernel::SceneTables<float>& tables) {
     job.edge_high.push_back(1.0f + tolerance);
   }
   job.edges = edge_tables(tables, job.edge_extra);
-  // The scene compiler marks every edge (link.w) where every room is convex.
   job.exit_by_nearest_line = tables.params.method == kMethodAnalytic &&
                              tables.polygons.size() > 1 && !job.edges.same_rooms &&
-                             tables.edges[0].link.w != 0;
+                             tables.params.convex != 0;
   return job;
 }
 

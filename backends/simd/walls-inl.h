@@ -40,8 +40,7 @@ class Walls {
         extra_(job.edge_extra.data()),
         high_(job.edge_high.data()),
         params_(job.tables->params),
-        features_(job.tables->features),
-        convex_(!job.tables->edges.empty() && job.tables->edges[0].link.w != 0) {
+        features_(job.tables->features) {
     // Passes over several rooms read each lane's edge from the scene's edge numbers: by a lookup
     // in up to Tuning::most_vectors vectors when the edges fit in them, else by a broadcast per
     // room blended by lane (cheaper than a gather), for scenes of up to kMostEdges edges.
@@ -149,7 +148,7 @@ class Walls {
           V& v = held.number[static_cast<size_t>(k)][f];
           v = Select(in, Splat(lookup_[f][static_cast<size_t>(poly.x + k)]), v);
         };
-        if (convex_) {
+        if (params_.convex != 0) {
           for (const Field f : kHeldLines) take(f);
         } else {
           for (const Field f : kHeldSegments) take(f);
@@ -265,7 +264,7 @@ class Walls {
   template <bool kOneRoom>
   FLATMARCH_PACKET_INLINE WallDistance wall_distance(const Rooms& rooms, const HeldEdges* held,
                                                      V px, V py) const {
-    if (!convex_) return nearest_edge<kOneRoom>(rooms, held, px, py);
+    if (params_.convex == 0) return nearest_edge<kOneRoom>(rooms, held, px, py);
     WallDistance w{Splat(kFar), SplatI(-1), Splat(kFar)};
     M lanes = None();
     const lane::vec2 p(px, py);
@@ -506,7 +505,6 @@ class Walls {
   SlotGluings by_slot_;  // glue_by_slot()
   KernelParams params_;
   uint features_;
-  bool convex_;  // every room is convex (the edge table's link.w): see wall_distance
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)

@@ -39,40 +39,44 @@ TEST(SceneCompiler, TorusTablesHoldItsEdgesAndMaps) {
   EXPECT_EQ(bottom.line, glm::dvec4(0, -1, 0, 1.0 / 16));  // outward normal, n.a, 1/|ab|^2
   EXPECT_EQ(bottom.map_linear, glm::dvec4(1, 0, 0, 1));
   EXPECT_EQ(bottom.map_shift, glm::dvec4(0, 4, 0, 0));
-  EXPECT_EQ(bottom.link, glm::ivec4(kEdgeGlued, 0, 2, 1));  // 1: the room is convex
+  EXPECT_EQ(bottom.link, glm::ivec4(kEdgeGlued, 0, 2, 0));
   const auto& right = t.edges[1];
   EXPECT_EQ(right.line, glm::dvec4(1, 0, 4, 1.0 / 16));
   EXPECT_EQ(right.map_shift, glm::dvec4(-4, 0, 0, 0));
-  EXPECT_EQ(right.link, glm::ivec4(kEdgeGlued, 0, 3, 1));
+  EXPECT_EQ(right.link, glm::ivec4(kEdgeGlued, 0, 3, 0));
   EXPECT_EQ(t.params.height, 2.0);
   EXPECT_EQ(t.params.top, 2.0);
   EXPECT_EQ(t.params.polygon_count, 1);
+  EXPECT_EQ(t.params.convex, 1);  // the square
 }
 
-// link.w marks every edge of a scene whose rooms are all convex, and no edge of any other:
-// a room that turns right once anywhere (the L-shape's corner, a 270-degree wedge) unmarks all.
-TEST(SceneCompiler, EdgesSayWhetherEveryRoomIsConvex) {
-  const auto marks = [](const std::string& json) {
-    std::vector<int> w;
-    for (const auto& e : kernel::compile_scene<float>(load(json), {}).edges) w.push_back(e.link.w);
-    return w;
+// The parameters' convex flag is 1 where every room of the scene is convex, else 0: a room that
+// turns right once anywhere (the L-shape's corner, a 270-degree wedge) clears it.
+TEST(SceneCompiler, ParamsSayWhetherEveryRoomIsConvex) {
+  const auto convex = [](const Scene& scene) {
+    const int flag = kernel::compile_scene<float>(scene, {}).params.convex;
+    EXPECT_EQ(kernel::compile_scene<double>(scene, {}).params.convex, flag);
+    return flag;
   };
-  EXPECT_EQ(marks(test::torus_json()), std::vector<int>(4, 1));
-  EXPECT_EQ(marks(test::cube_json()), std::vector<int>(24, 1));
+  EXPECT_EQ(convex(load(test::torus_json())), 1);
+  EXPECT_EQ(convex(load(test::cube_json())), 1);
+  EXPECT_EQ(convex(load_scene(std::filesystem::path(FLATMARCH_SOURCE_DIR) / "scenes/l_shape.json")),
+            0);
   // A square beside a pentagon with a point on its bottom edge (a straight angle): both convex.
-  EXPECT_EQ(marks(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]],
-                                   [[0, 0], [1, 0], [2, 0], [2, 1], [0, 1]]],
-                      "gluings": [[[0, 1], [1, 4]], [[0, 3], [1, 2]]]})"),
-            std::vector<int>(9, 1));
+  EXPECT_EQ(convex(load(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                        [[0, 0], [1, 0], [2, 0], [2, 1], [0, 1]]],
+                           "gluings": [[[0, 1], [1, 4]], [[0, 3], [1, 2]]]})")),
+            1);
   // The same with the pentagon's second corner pushed in: the first room is convex, the
-  // second not, so neither is marked.
-  EXPECT_EQ(marks(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]],
-                                   [[0, 0], [1, 0.5], [2, 0], [2, 1], [0, 1]]],
-                      "gluings": [[[0, 1], [1, 4]], [[0, 3], [1, 2]]]})"),
-            std::vector<int>(9, 0));
-  const Scene wedge = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, -1]}]],
-                               "gluings": [[[0, 0], [0, 2]]]})");
-  for (const auto& e : kernel::compile_scene<double>(wedge, {}).edges) EXPECT_EQ(e.link.w, 0);
+  // second not, so the scene is not.
+  EXPECT_EQ(convex(load(R"({"polygons": [[[0, 0], [1, 0], [1, 1], [0, 1]],
+                                        [[0, 0], [1, 0.5], [2, 0], [2, 1], [0, 1]]],
+                           "gluings": [[[0, 1], [1, 4]], [[0, 3], [1, 2]]]})")),
+            0);
+  // A wedge of three quarter-turns.
+  EXPECT_EQ(convex(load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, -1]}]],
+                           "gluings": [[[0, 0], [0, 2]]]})")),
+            0);
 }
 
 // In convex rooms the kernel's distance to the walls comes from the edges' lines, and so does
@@ -83,7 +87,7 @@ TEST(Kernel, WallDistanceInAConvexRoomIsTheDistanceToItsBoundary) {
   const Scene s =
       load_scene(std::filesystem::path(FLATMARCH_SOURCE_DIR) / "scenes/double_pentagon.json");
   const auto t = kernel::compile_scene<double>(s, {});
-  ASSERT_EQ(t.edges[0].link.w, 1);
+  ASSERT_EQ(t.params.convex, 1);
   ASSERT_EQ(t.features, kFeatureObjects);  // a hollow cube
   auto k = kernel::bind_kernel<double, kFeatureObjects>(t);
   const double eps = t.params.eps;
