@@ -635,7 +635,8 @@ def previous_section(results, previous, previous_path):
            + (f" The earlier run timed frames of {esc(sizes[0][0])} and judged {esc(sizes[0][1])}, this one "
               f"{esc(sizes[1][0])} and {esc(sizes[1][1])}: compare with care." if sizes[0] != sizes[1] else "")
            + "</p>"]
-    rank = {"pass": 0, "limit": 1, "fail": 2, "error": 3, None: -1}
+    # Worse the later in the vocabulary's order (pass, limit, fail, error, then the unfinished).
+    rank = {v: k for k, v in enumerate(VERDICTS)} | {None: -1}
     changed = [(n, verdict(was[n]), verdict(now[n])) for n in common if verdict(was[n]) != verdict(now[n])]
     changed.sort(key=lambda x: (rank[x[1]] >= rank[x[2]], x[0]))  # worse first
     if changed:
