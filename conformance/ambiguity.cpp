@@ -203,8 +203,8 @@ uint8_t segment_ambiguity(const Scene& scene, const PathSegment& seg, bool last,
         break;
       }
     }
-    // At an edge of the solid the normal, and so the colour, jumps: a hit within the kernel's
-    // normal step of one is a crease.
+    // At an edge of the solid the normal, and so the colour, jumps: a hit within `crease` of one
+    // is a crease.
     if (!exact || (bits & kSilhouette)) continue;
     // On a smooth surface the normals a shift to either side finds differ from this one by as
     // much; across an edge one side jumps.
@@ -239,12 +239,10 @@ RayTruth ray_truth(const Scene& scene, const Ray& ray, const MarchParams& params
   const OracleResult r = oracle_trace(scene, ray, exact, {.record_path = true});
   RayTruth truth{r.end, 0};
   if (r.end.hit == kHitVertex) truth.ambiguity |= kNearVertex;
-  // The kernel's normal is a central difference on a tetrahedron reaching sqrt(3) h from the
-  // point: within that of an edge of a solid it mixes both sides' normals (doubled: the point
-  // itself lies up to eps off the surface, which shifted lines cover).
-  const double crease = 2.0 * std::sqrt(3.0) *
-                        (params.precision == Precision::f32 ? kernel::normal_step<float>(scene)
-                                                            : kernel::normal_step<double>(scene));
+  // The kernel's normal is the gradient of the solid's term active at its point (maths.glsl's
+  // solid_normal_at), which lies up to eps off the surface: only that near an edge of the solid,
+  // and rounding, can give it the other side's (doubled, as the shifted lines cover).
+  const double crease = 2.0 * (params.eps + 16.0 * unit_roundoff(params.precision) * scene.scale);
   const double on = 1e-9 * scene.scale;
   // At a crossing the kernel maps its point, which stopped s in [0, eps] short of the edge, into
   // the new room and places it `offset` inside the edge it is now behind: the point moves

@@ -48,7 +48,7 @@ enum Ambiguity : uint8_t {
   kBandEdge = 4,       // meets an edge near the band's top or bottom, or leaves the band near one
   kSilhouette = 8,     // grazes an object: a shifted line decides the object otherwise
   kNearDistance = 16,  // ends within delta_n of max_distance, on either side
-  kCrease = 32         // hits a solid within the kernel's normal step of an edge of it
+  kCrease = 32         // hits a solid within eps (and rounding) of an edge of it
 };
 inline constexpr int kAmbiguityReasons = 6;
 // The bits that leave a ray's path undecided (its hit, crossings and t); a crease alone puts only

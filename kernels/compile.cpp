@@ -200,14 +200,6 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
   // ulps of the scene's scale (never less than the oracle's tolerance) it meets the vertex.
   constexpr double kUlp = std::numeric_limits<real>::epsilon();
   k.vertex_tolerance = real(std::max(kVertexTolerance, 8.0 * kUlp * scene.scale));
-  // The step of the central differences that give a solid's normal: a sixteenth of the one that
-  // balances rounding against truncation for smooth functions, cbrt(ulp) x scale. The solids'
-  // distances have creases (the hollow cube's faces are rings a few hundredths wide between its
-  // edges and its hole), and a stencil that straddles one mixes the normals of both sides: with
-  // the larger step 4.8% of an L-shape frame at a 20 degree field of view (the pixels of the
-  // hollow cubes) differed from the oracle's exact normals by more than 0.05, with this one 0.4%.
-  // Rounding stays far below that: ulp x scale / step is 2e-4 in float32.
-  k.normal_step = real(normal_step<real>(scene));
   set_look<real>(scene.look, k);
   k.period_tint = vec4(period_tint(scene));
   return t;

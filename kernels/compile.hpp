@@ -37,13 +37,6 @@ inline constexpr double kReach = 0x1p30;
 // scene's own camera; a caller that moves the camera checks its own.
 void check_reach(const Scene& scene, double max_distance, Vec2 camera);
 
-// The step of the central differences that give a solid's normal in `real` (compile.cpp says
-// why this one); the ambiguity mask's creases are as wide as the stencil reaches.
-template <typename real>
-double normal_step(const Scene& scene) {
-  return std::cbrt(static_cast<double>(std::numeric_limits<real>::epsilon())) * scene.scale / 16.0;
-}
-
 // `march.method` must be one the kernel runs (sphere, relaxed, analytic); throws as check_reach.
 template <typename real>
 SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march);

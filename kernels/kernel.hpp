@@ -23,10 +23,10 @@ struct Tables {
 #include "kernels/tables.glsl"
 };
 
-// The parameters as a std140 uniform block: 13 scalars, then 16-byte aligned vec4s.
+// The parameters as a std140 uniform block: 12 scalars, then 16-byte aligned vec4s.
 static_assert(offsetof(Tables<float>::KernelParams, convex) == 12 &&
-              offsetof(Tables<float>::KernelParams, fog) == 64 &&
-              sizeof(Tables<float>::KernelParams) == 160);
+              offsetof(Tables<float>::KernelParams, fog) == 48 &&
+              sizeof(Tables<float>::KernelParams) == 144);
 static_assert(sizeof(Tables<float>::EdgeRecord) == 96 && sizeof(Tables<float>::ObjectRecord) == 64);
 
 // A transport event as the kernel reports it (EventKind numbering, kEvent*).

@@ -302,8 +302,7 @@ real solid_entry(int polygon, vec3 o, vec3 d) {
 
 // The unit normal of solid k of the object table at p.
 vec3 solid_normal(int k, vec3 p) {
-  return solid_gradient(objects[k].info.x, vec3(objects[k].center), objects[k].shape, p,
-                        params.normal_step);
+  return solid_normal_at(objects[k].info.x, vec3(objects[k].center), objects[k].shape, p);
 }
 
 // Its normal and colour are left to the end of the march (solid_look): a shader runs all of a

@@ -68,17 +68,46 @@ KINLINE real solid_sdf(int solid, vec3 c, vec4 shape, vec3 p) {
   return max(box, shape.w - length(q));  // hollow cube: the cube minus the sphere
 }
 
-// The solid's unit normal at p: the gradient of its distance by central differences on a
-// tetrahedron of size h.
-KINLINE vec3 solid_gradient(int solid, vec3 c, vec4 shape, vec3 p, real h) {
-  vec3 a = vec3(real(1), real(-1), real(-1));
-  vec3 b = vec3(real(-1), real(-1), real(1));
-  vec3 f = vec3(real(-1), real(1), real(-1));
-  vec3 e = vec3(real(1), real(1), real(1));
-  return normalize(a * solid_sdf(solid, c, shape, p + h * a) +
-                   b * solid_sdf(solid, c, shape, p + h * b) +
-                   f * solid_sdf(solid, c, shape, p + h * f) +
-                   e * solid_sdf(solid, c, shape, p + h * e));
+// +1 or -1 as x is not negative or is.
+KINLINE real sign_of(real x) {
+  return select(x < real(0), real(-1), real(1));
+}
+
+// The outward unit normal at p of a box of half-extents `size` centred at the origin (p = q): its
+// face's where one of q's coordinates is beyond the box (or where q is inside, the nearest face's),
+// the gradient of the distance to its edge or corner where two or three are.
+KINLINE vec3 box_normal(vec3 q, vec3 size) {
+  vec3 w = abs(q) - size;
+  vec3 past = max(w, vec3(real(0)));
+  vec3 s = vec3(sign_of(q.x), sign_of(q.y), sign_of(q.z));
+  vec3 beyond = normalize(vec3(s.x * past.x, s.y * past.y, s.z * past.z));
+  vec3 face = select(w.x >= w.y && w.x >= w.z, vec3(s.x, real(0), real(0)),
+                     select(w.y >= w.z, vec3(real(0), s.y, real(0)), vec3(real(0), real(0), s.z)));
+  return select(w.x > real(0) || w.y > real(0) || w.z > real(0), beyond, face);
+}
+
+// The solid's outward unit normal at p from its own formula (solid_sdf's): the gradient of the
+// term of its distance that is active at p. A sphere's radius; a cylinder's side, cap or rim; a
+// box's face, edge or corner; a hollow cube's box, or its hollow. No finite differences: a point
+// near a crease takes the normal of its side, as the oracle's does.
+KINLINE vec3 solid_normal_at(int solid, vec3 c, vec4 shape, vec3 p) {
+  vec3 q = p - c;
+  if (solid == kSolidSphere) return normalize(q);
+  if (solid == kSolidCylinder) {
+    real rho = length(vec2(q));
+    vec2 w = vec2(rho - shape.x, abs(q.z) - shape.y);
+    vec3 side = normalize(vec3(q.x, q.y, real(0)));
+    vec3 cap = vec3(real(0), real(0), sign_of(q.z));
+    vec3 rim = normalize(vec3(w.x * side.x, w.x * side.y, w.y * cap.z));
+    return select(w.x > real(0) && w.y > real(0), rim, select(w.x > w.y, side, cap));
+  }
+  vec3 box = box_normal(q, vec3(shape));
+  if (solid == kSolidBox) return box;
+  // The hollow cube: the box where its distance is the larger term, else the hollow's sphere,
+  // whose normal points into the hollow.
+  vec3 w = abs(q) - vec3(shape);
+  real box_distance = length(max(w, vec3(real(0)))) + min(max(w.x, max(w.y, w.z)), real(0));
+  return select(box_distance >= shape.w - length(q), box, real(-1) * normalize(q));
 }
 
 // A solid's own colour when it has one (w > 0), else its normal's (DESIGN.md section 1).

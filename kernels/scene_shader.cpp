@@ -179,9 +179,9 @@ std::string baked_params(const Tables<float>::KernelParams& p) {
          std::to_string(p.max_steps) + ", " + std::to_string(p.polygon_count) + ", " +
          std::to_string(p.convex) + ",\n    " + number(p.eps) + ", " + number(p.offset) + ", " +
          number(p.max_distance) + ", " + number(p.omega) + ",\n    " + number(p.height) + ", " +
-         number(p.top) + ", " + number(p.vertex_tolerance) + ", " + number(p.normal_step) + ", " +
-         number(p.fog_distance) + ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.sky) +
-         ", " + vec4_literal(p.ground) + ", " + vec4_literal(p.wall) + ", " +
+         number(p.top) + ", " + number(p.vertex_tolerance) + ", " + number(p.fog_distance) +
+         ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.sky) + ", " +
+         vec4_literal(p.ground) + ", " + vec4_literal(p.wall) + ", " +
          vec4_literal(p.floor_colour) + ", " + vec4_literal(p.period_tint) + ");\n";
 }
 

@@ -25,7 +25,7 @@ struct ObjectRecord {
 };
 
 // Per-frame constants: the march parameters (DESIGN.md section 3), the band and the look. As a
-// std140 block the vec4s start at a 16-byte boundary after the 13 scalars; ALIGN16 says so in C++.
+// std140 block the vec4s start at a 16-byte boundary after the 12 scalars; ALIGN16 says so in C++.
 struct KernelParams {
   int method;  // kMethod*
   int max_steps;
@@ -38,7 +38,6 @@ struct KernelParams {
   real height;            // the walls span [0, height]
   real top;               // the period of a translation prism, else the height
   real vertex_tolerance;  // analytic: an exit this close to a vertex meets the vertex
-  real normal_step;       // step of the finite differences that give object normals
   real fog_distance;       // path length at which a surface is half fog
   ALIGN16 vec4 fog;       // the look (DESIGN.md section 1), linear RGB (xyz)
   vec4 sky;

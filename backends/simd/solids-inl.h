@@ -99,12 +99,11 @@ class Solids {
     return first;
   }
 
-  // The unit normal of solid k of the object table at p (maths.glsl's solid_gradient).
+  // The unit normal of solid k of the object table at p (maths.glsl's solid_normal_at).
   FLATMARCH_PACKET_INLINE lane::vec3 solid_normal(int k, V px, V py, V pz) const {
     const ObjectRecord& o = objects_[k];
-    return lane::solid_gradient(o.info.x, lane::vec3(lane::Broadcast(o.center)),
-                                lane::Broadcast(o.shape), lane::vec3(px, py, pz),
-                                params_.normal_step);
+    return lane::solid_normal_at(o.info.x, lane::vec3(lane::Broadcast(o.center)),
+                                 lane::Broadcast(o.shape), lane::vec3(px, py, pz));
   }
 
  private:
