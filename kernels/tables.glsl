@@ -38,7 +38,7 @@ struct KernelParams {
   real height;            // the walls span [0, height]
   real top;               // the period of a translation prism, else the height
   real vertex_tolerance;  // analytic: an exit this close to a vertex meets the vertex
-  real fog_distance;       // path length at which a surface is half fog
+  real fog_distance;      // path length at which a surface is half fog
   ALIGN16 vec4 fog;       // the look (DESIGN.md section 1), linear RGB (xyz)
   vec4 sky;
   vec4 ground;
