@@ -154,6 +154,7 @@ SceneTables<real> compile_scene(const Scene& scene, const MarchParams& march) {
         r.link.y = edge.to.polygon;
         r.link.z = edge.to.edge;
       }
+      r.seam = vec4(seam_record(scene, static_cast<int>(p), i));
       r.tint = vec4(edge_tint(scene.look, edge));
       t.edges.push_back(r);
     }
@@ -221,6 +222,23 @@ void check_reach(const Scene& scene, double max_distance, Vec2 camera) {
   }
 }
 
+glm::dvec4 seam_record(const Scene& scene, int polygon, int edge) {
+  const Polygon& room = scene.polygons[static_cast<size_t>(polygon)];
+  const Edge& e = room.edges[static_cast<size_t>(edge)];
+  if (e.shape == EdgeShape::at_infinity) return glm::dvec4(0.0);
+  const Vec2 along(-e.normal.y, e.normal.x);  // counterclockwise, from vertex edge to edge + 1
+  // Where a vertex lies along the edge, and what it is: an ideal one, nothing.
+  const auto end = [&](int v) -> std::pair<double, double> {
+    if (room.is_ideal(v)) return {0.0, 0.0};
+    const int c = scene.corner_class[static_cast<size_t>(polygon)][room.wrap(v)];
+    const bool cone = c >= 0 && scene.vertex_classes[static_cast<size_t>(c)].singular;
+    return {glm::dot(room.vertex(v), along), cone ? 2.0 : 1.0};
+  };
+  const auto [from, start_mark] = end(edge);
+  const auto [to, end_mark] = end(edge + 1);
+  return {from, to, start_mark, end_mark};
+}
+
 glm::dvec4 edge_tint(const Look& look, const Edge& edge) {
   switch (edge.kind) {
     case EdgeKind::glued:
@@ -244,6 +262,12 @@ void set_look(const Look& look, typename Tables<real>::KernelParams& params) {
   params.ground = colour(look.ground);
   params.wall = colour(look.wall);
   params.floor_colour = colour(look.floor);
+  const Look::Seams& seams = look.seams;
+  const bool on = seams.opacity > 0.0 || seams.cone_opacity > 0.0;
+  params.seams =
+      vec4(real(on ? seams.width : 0.0), real(seams.opacity), real(seams.cone_opacity), 0);
+  params.seam_colour = colour(seams.colour);
+  params.cone_colour = colour(seams.cone);
 }
 
 glm::dvec4 period_tint(const Scene& scene) {

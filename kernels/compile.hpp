@@ -49,6 +49,12 @@ glm::dvec4 edge_tint(const Look& look, const Edge& edge);
 // edge_tint: the colour after the gluings' (Look::gluing_colour).
 glm::dvec4 period_tint(const Scene& scene);
 
+// Edge `edge` of polygon `polygon` as the seams read it (the edge table's `seam`): where its
+// counterclockwise start (x) and end (y) lie along it, as dot(vertex, (-n.y, n.x)) with n its
+// outward normal, and what they are (z, w): 0 no corner (an ideal vertex; all 0 at infinity), 1 a
+// corner, 2 a corner of a cone point (VertexClass::singular).
+glm::dvec4 seam_record(const Scene& scene, int polygon, int edge);
+
 // The appearance part of the kernel's parameters.
 template <typename real>
 void set_look(const Look& look, typename Tables<real>::KernelParams& params);

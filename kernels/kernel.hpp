@@ -26,8 +26,9 @@ struct Tables {
 // The parameters as a std140 uniform block: 12 scalars, then 16-byte aligned vec4s.
 static_assert(offsetof(Tables<float>::KernelParams, convex) == 12 &&
               offsetof(Tables<float>::KernelParams, fog) == 48 &&
-              sizeof(Tables<float>::KernelParams) == 144);
-static_assert(sizeof(Tables<float>::EdgeRecord) == 96 && sizeof(Tables<float>::ObjectRecord) == 64);
+              sizeof(Tables<float>::KernelParams) == 192);
+static_assert(sizeof(Tables<float>::EdgeRecord) == 112 &&
+              sizeof(Tables<float>::ObjectRecord) == 64);
 
 // A transport event as the kernel reports it (EventKind numbering, kEvent*).
 struct KernelEvent {

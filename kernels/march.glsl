@@ -209,6 +209,19 @@ void tint_ray(INOUT(Ray) r, vec4 tint, real cosine) {
   r.clear = r.clear * (real(1) - a);
 }
 
+// A ray crossing `edge` of its room near one of the wall's vertical edges, its top or its bottom
+// passes a seam first (DESIGN.md section 1, Appearance): a line of a constant angle (params.seams.x
+// radians: the same pixels wide near and far), drawn whatever crosses the wall, glued or mirror.
+void seam_ray(INOUT(Ray) r, EdgeRecord edge) {
+  if (params.seams.x > real(0)) {
+    real kind = seam_kind(r.o, edge.line, edge.seam, real(0.5f) * params.seams.x * r.t, params.top);
+    real a = seam_opacity(kind, params.seams);
+    vec3 colour = seam_colour(kind, params.seam_colour, params.cone_colour);
+    r.light = tint_light(r.light, r.clear, a, fogged(colour, vec3(params.fog), r.t, params.fog_distance));
+    r.clear = r.clear * (real(1) - a);
+  }
+}
+
 // A ray at edge k of its polygon goes through it into the glued room, or is reflected by a
 // mirror. Either way its point is then placed `push` inside the edge it is now behind (the
 // paper's "safe distance greater than eps" from the new wall), wherever within eps of the old
@@ -217,6 +230,7 @@ void cross_edge(INOUT(Ray) r, int k, real push) {
   EdgeRecord edge = edge_at(r.polygon, k);
   vec4 line = edge.line;
   vec2 dh = vec2(r.d);
+  seam_ray(r, edge);
   tint_ray(r, edge.tint, dot(dh, vec2(line.x, line.y)));
   if (has(kFeatureMirrors) && edge.link.x == kEdgeMirror) {
     record_event(kEventMirror, r.polygon, k, -1, -1, -1, r.t, r.o);

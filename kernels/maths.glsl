@@ -227,6 +227,28 @@ KINLINE vec3 fogged(vec3 surface, vec3 fog, real t, real fog_distance) {
   return surface + f * (fog - surface);
 }
 
+// Which seam a ray crossing a glued wall or a mirror at p passes (DESIGN.md section 1,
+// Appearance): 2 where p lies within half_width of the wall's vertical edge at a cone point, 1
+// within it of one at another corner or of the wall's bottom or top (z = 0, top), else 0. line:
+// the edge's (its outward unit normal n in x, y); seam: the edge table's (where its ends lie along
+// (-n.y, n.x), and what they are).
+KINLINE real seam_kind(vec3 p, vec4 line, vec4 seam, real half_width, real top) {
+  real u = dot(vec2(p.x, p.y), vec2(-line.y, line.x));  // along the edge, counterclockwise
+  real corner = max(select(u - seam.x < half_width, seam.z, real(0)),
+                    select(seam.y - u < half_width, seam.w, real(0)));
+  return max(corner, select(p.z < half_width || p.z > top - half_width, real(1), real(0)));
+}
+
+// The opacity of a seam of kind `kind` (seam_kind): seams.y, at a cone point seams.z, none at 0.
+KINLINE real seam_opacity(real kind, vec4 seams) {
+  return select(kind > real(0.5f), select(kind > real(1.5f), seams.z, seams.y), real(0));
+}
+
+// ... and its colour: `cone` at a cone point, else `seam`.
+KINLINE vec3 seam_colour(real kind, vec4 seam, vec4 cone) {
+  return select(kind > real(1.5f), vec3(cone), vec3(seam));
+}
+
 // What a ray that leaves the band or misses every room sees, by the height dz of its unit
 // direction: the fog at the horizon, growing towards the sky straight up and the ground
 // straight down.

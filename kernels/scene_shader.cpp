@@ -182,7 +182,9 @@ std::string baked_params(const Tables<float>::KernelParams& p) {
          number(p.top) + ", " + number(p.vertex_tolerance) + ", " + number(p.fog_distance) +
          ",\n    " + vec4_literal(p.fog) + ", " + vec4_literal(p.sky) + ", " +
          vec4_literal(p.ground) + ", " + vec4_literal(p.wall) + ", " +
-         vec4_literal(p.floor_colour) + ", " + vec4_literal(p.period_tint) + ");\n";
+         vec4_literal(p.floor_colour) + ", " + vec4_literal(p.period_tint) + ",\n    " +
+         vec4_literal(p.seams) + ", " + vec4_literal(p.seam_colour) + ", " +
+         vec4_literal(p.cone_colour) + ");\n";
 }
 
 std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays) {
@@ -193,11 +195,12 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays)
   s += array(constant_arrays, "ivec4", "polygons", tables.polygons, zeroi, ivec4_literal);
   s += array(constant_arrays, "EdgeRecord", "edges", tables.edges,
              "EdgeRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi +
-                 ", " + zero4 + ")",
+                 ", " + zero4 + ", " + zero4 + ")",
              [](const Edge& e) {
                return "EdgeRecord(" + vec4_literal(e.segment) + ", " + vec4_literal(e.line) + ", " +
                       vec4_literal(e.map_linear) + ", " + vec4_literal(e.map_shift) + ", " +
-                      ivec4_literal(e.link) + ", " + vec4_literal(e.tint) + ")";
+                      ivec4_literal(e.link) + ", " + vec4_literal(e.tint) + ", " +
+                      vec4_literal(e.seam) + ")";
              });
   s += array(constant_arrays, "ObjectRecord", "objects", tables.objects,
              "ObjectRecord(" + zero4 + ", " + zero4 + ", " + zero4 + ", " + zeroi + ")",

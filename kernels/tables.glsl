@@ -13,6 +13,9 @@ struct EdgeRecord {
   ivec4 link;       // kind (kEdge*), destination polygon, destination edge, 0 (unused)
   vec4 tint;        // glued or mirror: the colour (xyz) a crossing mixes in, and its opacity at
                     // normal incidence (w); a wall: 0
+  vec4 seam;        // where its ends lie along it, dot(end, (-n.y, n.x)): the counterclockwise
+                    // start (x) and end (y); what they are (z, w): 0 no corner (out at infinity),
+                    // 1 a corner, 2 a cone point's corner (the seams, DESIGN.md section 1)
 };
 
 // One solid in one polygon's room.
@@ -45,4 +48,7 @@ struct KernelParams {
   vec4 wall;
   vec4 floor_colour;
   vec4 period_tint;  // a translation prism's floor and ceiling, glued: as an edge's tint
+  vec4 seams;        // width per unit of path length (x; 0: no seams), opacity (y), at cone points (z)
+  vec4 seam_colour;  // of a seam at a corner, the top or the bottom of a wall (xyz)
+  vec4 cone_colour;  // ... at a cone point's corner (xyz)
 };

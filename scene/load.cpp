@@ -350,6 +350,38 @@ void read_camera(const JsonNode& root, Scene& scene) {
   }
 }
 
+// "seams": false, or {"width", "opacity", "colour", "cones"}: "cones" a colour, or false to
+// draw cone points as the other corners.
+void read_seams(const JsonNode& node, Look::Seams& seams) {
+  if (node.json().is_boolean()) {
+    if (!node.boolean()) seams.opacity = seams.cone_opacity = 0.0;
+    return;
+  }
+  node.object();
+  node.allow_keys({"width", "opacity", "colour", "cones"});
+  if (node.has("width")) {
+    seams.width = node["width"].positive();
+    if (seams.width > 0.5)
+      node["width"].fail("the seams' width is an angle in radians, at most 0.5");
+  }
+  if (node.has("opacity")) {
+    seams.opacity = seams.cone_opacity = node["opacity"].number();
+    if (seams.opacity < 0.0 || seams.opacity > 1.0) node["opacity"].fail("opacity lies in [0, 1]");
+  }
+  if (node.has("colour")) seams.colour = node["colour"].color();
+  if (node.has("cones")) {
+    const JsonNode cones = node["cones"];
+    if (cones.json().is_boolean()) {
+      if (cones.boolean())
+        cones.fail("\"cones\" is a colour, or false to draw cone points as the other corners");
+      seams.cone = seams.colour;
+      seams.cone_opacity = seams.opacity;
+    } else {
+      seams.cone = cones.color();
+    }
+  }
+}
+
 void read_look(const JsonNode& root, Scene& scene) {
   if (!root.has("look")) return;
   const JsonNode node = root["look"];
@@ -357,8 +389,8 @@ void read_look(const JsonNode& root, Scene& scene) {
     node["background"].fail(
         "the background is now a gradient: give \"sky\" (straight up) and "
         "\"ground\" (straight down); the horizon takes \"fog\"");
-  node.allow_keys(
-      {"wall_tint", "fog", "fog_distance", "sky", "ground", "wall", "floor", "mirror", "gluings"});
+  node.allow_keys({"wall_tint", "fog", "fog_distance", "sky", "ground", "wall", "floor", "mirror",
+                   "gluings", "seams"});
   Look& look = scene.look;
   if (node.has("wall_tint")) {
     look.wall_tint = node["wall_tint"].number();
@@ -377,6 +409,7 @@ void read_look(const JsonNode& root, Scene& scene) {
     const size_t n = list.array_size(0, scene.gluings.size() + (scene.period ? 1 : 0));
     for (size_t k = 0; k < n; ++k) look.gluings.push_back(list[k].color());
   }
+  if (node.has("seams")) read_seams(node["seams"], look.seams);
 }
 
 }  // namespace

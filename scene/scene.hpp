@@ -182,13 +182,26 @@ struct Look {
   Vec3 ground{0.06, 0.055, 0.05};  // straight down, below it
   Vec3 wall{0.55, 0.55, 0.55};     // opaque walls, lit
   Vec3 floor{0.55, 0.55, 0.55};    // the floor's light checks, lit (the dark ones are darker)
-  Vec3 mirror{0.3, 0.35, 0.45};    // a mirror's tint: a dark, bluish silver
+  Vec3 mirror{0.05, 0.055, 0.07};  // a mirror's tint: a dark, bluish silver (lighter, the
+                                   // reflections of an empty mirror room swam in it)
   // A colour per gluing, in the scene's gluing order, and in a translation prism one more for its
   // glued floor and ceiling; gluings beyond these take the palette's
   // at kPaletteShade of its light (the colours mix into what rays see, and far enough away
   // into the horizon: full-strength colours would wash it out).
   std::vector<Vec3> gluings;
   static constexpr double kPaletteShade = 0.4;
+  // Seams: a ray crossing a glued wall or a mirror near one of the wall's vertical edges (a
+  // corner of its polygon) or near its top or bottom passes a line painted on it first, so that
+  // the panels of a tiling read at once. The line is `width` radians of view wide (at path length
+  // t, width * t: the same number of pixels near and far); opacity 0 turns seams off. Corners
+  // whose vertex class is a cone point (VertexClass::singular) take `cone` instead.
+  struct Seams {
+    double width = 0.008;            // about 1.9 pixels at the default 640x360, fov 75
+    double opacity = 0.7;            // of the line; 0: no seams
+    Vec3 colour{0.01, 0.01, 0.012};  // regular corners, the top and the bottom
+    Vec3 cone{0.85, 0.35, 0.05};     // cone points
+    double cone_opacity = 0.8;
+  } seams;
 
   // The colour of gluing k (the floor plan draws the pair in it).
   Vec3 gluing_colour(int k) const;

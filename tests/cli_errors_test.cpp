@@ -230,6 +230,15 @@ std::vector<Case> cases() {
       {"gluing_colours", with_square(R"("look": {"gluings": [[1, 0, 0]]})"), "/look/gluings",
        "at most 0"},
       {"sky_colour", with_square(R"("look": {"sky": [0.5, 0.5]})"), "/look/sky", "3"},
+      {"seams_kind", with_square(R"("look": {"seams": "dark"})"), "/look/seams", "object"},
+      {"seams_key", with_square(R"("look": {"seams": {"colour": [0, 0, 0], "wdth": 1}})"),
+       "/look/seams/wdth", "unknown key"},
+      {"seams_width", with_square(R"("look": {"seams": {"width": 2}})"), "/look/seams/width",
+       "radians"},
+      {"seams_opacity", with_square(R"("look": {"seams": {"opacity": -0.5}})"),
+       "/look/seams/opacity", "[0, 1]"},
+      {"seams_cones", with_square(R"("look": {"seams": {"cones": true}})"), "/look/seams/cones",
+       "false to draw cone points"},
   };
 }
 

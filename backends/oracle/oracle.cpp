@@ -168,6 +168,7 @@ class Tracer {
       case EdgeKind::wall:
         return finish(EventKind::wall, kHitWall, exit.s, exit.edge, Vec3(-edge.normal, 0.0));
       case EdgeKind::mirror: {
+        seam(exit.edge, at, t_ + exit.s);
         tint(edge, dh, t_ + exit.s);
         record({.kind = EventKind::mirror,
                 .polygon = p_,
@@ -180,6 +181,7 @@ class Tracer {
         break;
       }
       case EdgeKind::glued: {
+        seam(exit.edge, at, t_ + exit.s);
         tint(edge, dh, t_ + exit.s);
         record({.kind = EventKind::gluing,
                 .polygon = p_,
@@ -201,6 +203,26 @@ class Tracer {
     }
     ++out_.end.crossings;
     return false;
+  }
+
+  // A crossing of edge `e` of the ray's room at `at`, path length t, near a vertical edge of the
+  // wall, its top or its bottom, passes a seam first (the kernel's seam_ray).
+  void seam(int e, Vec3 at, double t) {
+    const Look& look = scene_.look;
+    if (look.seams.opacity <= 0.0 && look.seams.cone_opacity <= 0.0) return;
+    const Edge& edge = scene_.polygons[static_cast<size_t>(p_)].edges[static_cast<size_t>(e)];
+    const double top = scene_.period ? *scene_.period : scene_.height;
+    const double kind =
+        maths_.seam_kind(at, glm::dvec4(edge.normal, 0.0, 0.0), kernel::seam_record(scene_, p_, e),
+                         0.5 * look.seams.width * t, top);
+    RayEnd& end = out_.end;
+    const glm::dvec4 seams(look.seams.width, look.seams.opacity, look.seams.cone_opacity, 0.0);
+    const double a = maths_.seam_opacity(kind, seams);
+    const Vec3 colour = maths_.seam_colour(kind, glm::dvec4(look.seams.colour, 0.0),
+                                           glm::dvec4(look.seams.cone, 0.0));
+    end.light = maths_.tint_light(end.light, end.clear, a,
+                                  maths_.fogged(colour, look.fog, t, look.fog_distance));
+    end.clear *= 1.0 - a;
   }
 
   // The glued wall or mirror `edge`, met at path length t, tints what lies beyond it (the

@@ -52,8 +52,10 @@ void slot_gluings(const kernel::SceneTables<float>& tables, EdgeTables& t) {
         if (tints.size() == kAlikeSlots) return;
         tint = tints.insert(tints.end(), e.tint);
       }
-      code.push_back(e.link.y | static_cast<int32_t>(tint - tints.begin()) << 16);
+      code.push_back(e.link.y | static_cast<int32_t>(tint - tints.begin()) << 16 |
+                     static_cast<int32_t>(e.seam.z) << 24 | static_cast<int32_t>(e.seam.w) << 26);
     }
+
   t.glue_by_slot = true;
   t.slot_code = std::move(code);
   t.tints = std::move(tints);
@@ -122,6 +124,7 @@ EdgeTables edge_tables(const kernel::SceneTables<float>& tables,
                                               edge.tint.z,
                                               edge.tint.w};
     for (size_t f = 0; f < kGlueFields; ++f) t.glue[f][e] = glue[f];
+    for (size_t f = 0; f < 4; ++f) t.seam[f].push_back(edge.seam[static_cast<int>(f)]);
     t.to_polygon[e] = glued ? link.y : 0;
     t.wall[e] = link.x == kEdgeWall ? -1 : 0;
     t.same_tint =
@@ -137,6 +140,16 @@ EdgeTables edge_tables(const kernel::SceneTables<float>& tables,
     t.glue_alike |= 1u << f;
     t.glue_number[f] = *number;
   }
+  // Where the seams' ends lie, alike slot by slot (rooms drawn in one place, of as many edges).
+  t.seam_by_slot = t.same_count && t.most_edges <= kAlikeSlots && !tables.polygons.empty();
+  for (size_t f = 0; f < 2 && t.seam_by_slot; ++f)
+    for (int k = 0; k < t.most_edges && t.seam_by_slot; ++k) {
+      const std::optional<float> number = alike([&](const auto& take) {
+        for (const ivec4& p : tables.polygons) take(t.seam[f][static_cast<size_t>(p.x + k)]);
+      });
+      t.seam_by_slot = number.has_value();
+      if (number) t.slot_seam[f][static_cast<size_t>(k)] = *number;
+    }
   slot_gluings(tables, t);
   return t;
 }

@@ -71,9 +71,10 @@ struct EdgeTables {
   // Bit f: number f of glue alike at every glued edge, glue_number[f].
   uint32_t glue_alike = 0;
   std::array<float, kGlueFields> glue_number{};
-  std::vector<int32_t> to_polygon;  // of each edge: the room it is glued to, else 0
-  std::vector<int32_t> wall;        // of each edge: -1 an opaque wall, else 0
-  bool same_tint = true;            // every edge, glued or not, has the same tint
+  std::array<std::vector<float>, 4> seam;  // [field][edge]: EdgeRecord::seam, for crossings
+  std::vector<int32_t> to_polygon;         // of each edge: the room it is glued to, else 0
+  std::vector<int32_t> wall;               // of each edge: -1 an opaque wall, else 0
+  bool same_tint = true;                   // every edge, glued or not, has the same tint
   // Gluings alike slot by slot: every room has most_edges edges (at most kAlikeSlots), all
   // glued, and edge k of every room is glued by the same numbers (glue fields below
   // kSlotGlueFields: the map, the destination edge's line, the edge's normal), as on a
@@ -82,8 +83,14 @@ struct EdgeTables {
   // of slot_code.
   bool glue_by_slot = false;
   std::array<std::array<float, kAlikeSlots>, kSlotGlueFields> slot_glue{};  // [field][slot]
-  std::vector<int32_t> slot_code;  // [room * most_edges + slot]: destination room | tint << 16
-  std::vector<glm::vec4> tints;    // the tints slot_code numbers
+  // [room * most_edges + slot]: destination room | tint << 16 | what the edge's ends are for the
+  // seams (EdgeRecord::seam's z and w, 0 to 2) << 24 and << 26.
+  std::vector<int32_t> slot_code;
+  // Where each slot's ends lie along it (EdgeRecord::seam's x and y) alike in every room (rooms
+  // drawn in one place): by slot, so that a crossing reads its seam with no gather.
+  bool seam_by_slot = false;
+  std::array<std::array<float, kAlikeSlots>, 2> slot_seam{};
+  std::vector<glm::vec4> tints;  // the tints slot_code numbers
 };
 
 // The edge tables of `tables`, whose edges' edge_extra is `extra`.

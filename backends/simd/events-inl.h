@@ -112,6 +112,8 @@ class RayEvents {
         tint.z = Select(mk, Splat(e.tint.z), tint.z.v);
         tint.w = Select(mk, Splat(e.tint.w), tint.w.v);
       }
+      if (params_.seams.x > 0.0f)
+        Seam(r, mk, params_, lane::Broadcast(e.line), lane::Broadcast(e.seam));
       lane::vec2 p = o, h = d;
       V hz = r.dz;
       if (has(kFeatureMirrors) && e.link.x == kEdgeMirror) {

@@ -28,11 +28,14 @@ namespace HWY_NAMESPACE {
 // edge they are then behind: `glue(f)` gives each lane's glue field f (EdgeTables), `tint` its
 // edge's tint. `cosine`: the rays' component along their edges' normals where the caller has it
 // (the analytic method's Exit::cosine, the same numbers), else null: then computed from glue
-// fields 9 and 10. The caller records the event.
-template <typename Glue>
+// fields 9 and 10. `seam_of()` gives each lane's edge's seam record, read only where the look has
+// seams. The caller records the event.
+template <typename Glue, typename SeamOf>
 FLATMARCH_PACKET_INLINE void GlueRays(Packet& r, M m, const KernelParams& params, uint features,
-                                      const Glue& glue, const lane::vec4& tint, VI to, V push,
-                                      const V* cosine) {
+                                      const Glue& glue, const SeamOf& seam_of,
+                                      const lane::vec4& tint, VI to, V push, const V* cosine) {
+  if (params.seams.x > 0.0f)
+    Seam(r, m, params, lane::vec4{glue(9), glue(10), 0.0f, 0.0f}, seam_of());
   const lane::vec4 linear{glue(2), glue(3), glue(4), glue(5)};
   const lane::vec4 shift{glue(0), glue(1), 0.0f, 0.0f};
   const lane::vec4 to_line{glue(6), glue(7), glue(8), 0.0f};
@@ -63,6 +66,10 @@ class SlotGluings {
     on_ = true;
     two_tint_vectors_ = t.tints.size() > hn::Lanes(D());
     glue_ = t.slot_glue;
+    // Rooms of most_edges edges each, in order: a lane's slot code is at its edge's index.
+    for (size_t c = 0; c < 2; ++c) seam_[c] = t.seam[c].data();
+    seam_by_slot_ = t.seam_by_slot;
+    slot_seam_ = t.slot_seam;
     for (size_t c = 0; c < 4; ++c)
       for (size_t k = 0; k < t.tints.size(); ++k) tint_[c][k] = t.tints[k][static_cast<int>(c)];
     code_ = t.slot_code.data();
@@ -81,11 +88,23 @@ class SlotGluings {
     const VI code = hn::GatherIndex(di, code_, at);
     // The tints in one vector, or two (AVX2: the staircases' ten on 8 lanes; AVX-512's 16
     // lanes hold every tint glue_by_slot allows).
-    const VI number = hn::ShiftRight<16>(code);
+    const VI number = hn::And(hn::ShiftRight<16>(code), SplatI(0xff));
     const auto tint = [&](size_t c) FLATMARCH_PACKET_LAMBDA {
       return LookUp(D(), tint_[c].data(), two_tint_vectors_ ? 2 : 1, number);
     };
-    GlueRays(r, m, params, features, glue, lane::vec4{tint(0), tint(1), tint(2), tint(3)},
+    // The seam records: what the ends are from the code, where they lie by slot where the rooms
+    // are drawn in one place, else by a gather each.
+    const auto seam_of = [&]() FLATMARCH_PACKET_LAMBDA {
+      const auto end = [&](int shift) FLATMARCH_PACKET_LAMBDA {
+        return hn::ConvertTo(D(), hn::And(hn::ShiftRightSame(code, shift), SplatI(3)));
+      };
+      const auto place = [&](size_t c) FLATMARCH_PACKET_LAMBDA {
+        return seam_by_slot_ ? hn::TableLookupLanes(hn::LoadU(D(), slot_seam_[c].data()), by_slot)
+                             : hn::GatherIndex(D(), seam_[c], at);
+      };
+      return lane::vec4{place(0), place(1), end(24), end(26)};
+    };
+    GlueRays(r, m, params, features, glue, seam_of, lane::vec4{tint(0), tint(1), tint(2), tint(3)},
              hn::And(code, SplatI(0xffff)), push, cosine);
   }
 
@@ -95,6 +114,9 @@ class SlotGluings {
   std::array<std::array<float, kAlikeSlots>, kSlotGlueFields> glue_{};
   std::array<std::array<float, kAlikeSlots>, 4> tint_{};
   const int32_t* code_ = nullptr;
+  std::array<const float*, 2> seam_{};  // where the edges' ends lie (EdgeTables::seam)
+  bool seam_by_slot_ = false;           // ... alike slot by slot (EdgeTables::slot_seam)
+  std::array<std::array<float, kAlikeSlots>, 2> slot_seam_{};
   int count_ = 0;
 };
 

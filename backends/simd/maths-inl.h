@@ -192,6 +192,28 @@ HWY_INLINE void Normalize(V& x, V& y, V& z) {
   z = n.z.v;
 }
 
+// The rays of `m` at a glued wall or mirror, about to cross it, pass its seam where they are near
+// one of its vertical edges, its top or its bottom (march.glsl's seam_ray; the caller checks that
+// the look has seams): `line` and `seam` are the edge table's.
+HWY_INLINE void Seam(Packet& r, M m, const KernelParams& params, const lane::vec4& line,
+                     const lane::vec4& seam) {
+  const lane::real kind =
+      lane::seam_kind(lane::vec3(r.ox, r.oy, r.oz), line, seam,
+                      lane::real(0.5f) * lane::real(params.seams.x) * lane::real(r.t), params.top);
+  // Most crossings pass no seam, and a seam of kind 0 leaves the light as it is, bit for bit.
+  if (hn::AllFalse(D(), hn::And(m, kind.v > Splat(0.0f)))) return;
+  const lane::real a = lane::seam_opacity(kind, lane::Broadcast(params.seams));
+  const lane::vec3 colour =
+      lane::fogged(lane::seam_colour(kind, lane::Broadcast(params.seam_colour),
+                                     lane::Broadcast(params.cone_colour)),
+                   lane::vec3(lane::Broadcast(params.fog)), r.t, params.fog_distance);
+  const lane::vec3 light = lane::tint_light(lane::vec3(r.lr, r.lg, r.lb), r.clear, a, colour);
+  r.lr = Select(m, light.x.v, r.lr);
+  r.lg = Select(m, light.y.v, r.lg);
+  r.lb = Select(m, light.z.v, r.lb);
+  r.clear = Select(m, (lane::real(r.clear) * (lane::real(1.0f) - a)).v, r.clear);
+}
+
 // The rays of `m` cross a glued wall or mirror of tint `tint` (the edge table's) whose outward
 // unit normal is n: march.glsl's cross_edge mixes its colour, fogged, into what they see.
 HWY_INLINE void Tint(Packet& r, M m, const KernelParams& params, const lane::vec4& tint,

@@ -96,6 +96,7 @@ class Walls {
     copy(wall_, t.wall);
     copy(to_polygon_, t.to_polygon);
     for (size_t f = 0; f < kGlueFields; ++f) copy(glue_[f], t.glue[f]);
+    for (size_t f = 0; f < 4; ++f) copy(seam_[f], t.seam[f]);
     if ((modes & kModeAlike) != 0u) {
       glue_alike_ = t.glue_alike;
       glue_number_ = t.glue_number;
@@ -451,7 +452,12 @@ class Walls {
       return ((glue_alike_ >> f) & 1u) != 0u ? Splat(glue_number_[f]) : lookup(D(), glue_[f], at);
     };
     const lane::vec4 tint{glue(11), glue(12), glue(13), glue(14)};
-    GlueRays(r, m, params_, features_, glue, tint, lookup(DI(), to_polygon_, at), push, cosine);
+    const auto seam_of = [&]() FLATMARCH_PACKET_LAMBDA {
+      return lane::vec4{lookup(D(), seam_[0], at), lookup(D(), seam_[1], at),
+                        lookup(D(), seam_[2], at), lookup(D(), seam_[3], at)};
+    };
+    GlueRays(r, m, params_, features_, glue, seam_of, tint, lookup(DI(), to_polygon_, at), push,
+             cosine);
   }
 
   // Whether crossings read each lane's gluing by its slot (EdgeTables::glue_by_slot), in scenes
@@ -505,6 +511,10 @@ class Walls {
   SlotGluings by_slot_;  // glue_by_slot()
   KernelParams params_;
   uint features_;
+  // Of each edge: its seam record (EdgeRecord::seam), read by crossings where the look has seams.
+  // Last: placed among the tables above, the AVX2 frames took 1.14-1.23x the time even with seams
+  // off, here the same (SSE4's took 1.15-1.20x either way: not understood; backends/simd/NOTES.md).
+  std::array<Table<float>, 4> seam_;
 };
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)

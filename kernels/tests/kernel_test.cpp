@@ -39,10 +39,14 @@ TEST(SceneCompiler, TorusTablesHoldItsEdgesAndMaps) {
   EXPECT_EQ(bottom.line, glm::dvec4(0, -1, 0, 1.0 / 16));  // outward normal, n.a, 1/|ab|^2
   EXPECT_EQ(bottom.map_linear, glm::dvec4(1, 0, 0, 1));
   EXPECT_EQ(bottom.map_shift, glm::dvec4(0, 4, 0, 0));
+  // For the seams: its ends at x = 0 and 4 along it (counterclockwise, (-n.y, n.x) = (1, 0)), both
+  // corners of a regular point (the torus's one vertex class, of angle 2 pi).
+  EXPECT_EQ(bottom.seam, glm::dvec4(0, 4, 1, 1));
   EXPECT_EQ(bottom.link, glm::ivec4(kEdgeGlued, 0, 2, 0));
   const auto& right = t.edges[1];
   EXPECT_EQ(right.line, glm::dvec4(1, 0, 4, 1.0 / 16));
   EXPECT_EQ(right.map_shift, glm::dvec4(-4, 0, 0, 0));
+  EXPECT_EQ(right.seam, glm::dvec4(0, 4, 1, 1));  // along (0, 1), from y = 0 to 4
   EXPECT_EQ(right.link, glm::ivec4(kEdgeGlued, 0, 3, 0));
   EXPECT_EQ(t.params.height, 2.0);
   EXPECT_EQ(t.params.top, 2.0);

@@ -592,6 +592,94 @@ TEST(OracleRender, AGluedWallTintsInItsColourMoreAtGrazingIncidence) {
   }
 }
 
+// Seams (DESIGN.md section 1, Appearance), by hand: walls that tint nothing, a black fog far away,
+// seams 0.1 radians wide of opacity 0.5, blue at corners and the band's ends, red at cone points.
+// A ray that crosses a wall within 0.05 t (half the width at path length t) of a vertical edge
+// of it, or of its bottom or top, gathers half the seam's colour and lets half through; elsewhere
+// nothing. The torus's corners are one regular point; the L-shape's eight one cone point of 6 pi.
+TEST(OracleRender, ASeamMarksACrossingNearACornerTheTopOrTheBottom) {
+  const std::string look =
+      R"("look": {"wall_tint": 0, "fog": [0, 0, 0], "fog_distance": 1e9,
+                  "seams": {"width": 0.1, "opacity": 0.5, "colour": [0, 0, 1], "cones": [1, 0, 0]}})";
+  const Scene torus = load(test::torus_json(look));
+  const Scene l_shape = load(R"({"polygons": [[[0, 0], [2, 0], [4, 0], [4, 2], [2, 2], [2, 4],
+                                               [0, 4], [0, 2]]],
+      "gluings": [[[0, 0], [0, 5]], [[0, 1], [0, 3]], [[0, 2], [0, 7]], [[0, 4], [0, 6]]], )" +
+                             look + "}");
+  const Vec3 none(0.0), seam(0, 0, 0.5), cone(0.5, 0, 0);
+  struct Case {
+    const Scene* scene;
+    Vec3 from, dir;
+    Vec3 light;  // what the crossing gathers
+  };
+  const Case cases[] = {
+      // The torus's right wall (x = 4) at t = 2: a seam within 0.1 of y = 0 or 4 and z = 0 or 2.
+      {&torus, {2, 2, 1}, {1, 0, 0}, none},
+      {&torus, {2, 0.09, 1}, {1, 0, 0}, seam},
+      {&torus, {2, 0.11, 1}, {1, 0, 0}, none},
+      {&torus, {2, 3.92, 1}, {1, 0, 0}, seam},
+      {&torus, {2, 2, 0.05}, {1, 0, 0}, seam},
+      {&torus, {2, 2, 1.95}, {1, 0, 0}, seam},
+      {&torus, {2, 2, 1.85}, {1, 0, 0}, none},
+      // The L-shape's right wall (x = 4, y in [0, 2]) at t = 1: a cone point's edge within 0.05.
+      {&l_shape, {3, 1.96, 1}, {1, 0, 0}, cone},
+      {&l_shape, {3, 0.03, 1}, {1, 0, 0}, cone},
+      {&l_shape, {3, 1.9, 1}, {1, 0, 0}, none},
+      {&l_shape, {3, 1, 0.02}, {1, 0, 0}, seam},  // its bottom: a seam, not a cone point
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(testing::Message() << "from " << c.from.x << ", " << c.from.y << ", " << c.from.z);
+    MarchParams params;
+    params.max_distance = c.from.x == 2 ? 3.0 : 1.5;  // past the wall, before the next
+    const RayEnd end = trace(*c.scene, c.from, c.dir, 0, params).end;
+    ASSERT_EQ(end.crossings, 1);
+    expect_near(end.light, c.light, 1e-8);
+    EXPECT_NEAR(end.clear, c.light == none ? 1.0 : 0.5, 1e-12);
+    // The kernel, in float64, gathers the same.
+    params.method = Method::analytic;
+    const auto tables = kernel::compile_scene<double>(*c.scene, params);
+    auto k = kernel::bind_kernel<double, 0u>(tables);
+    const auto r = k.march(0, c.from, c.dir);
+    EXPECT_EQ(r.crossings, 1);
+    expect_near(Vec3(r.light), c.light, 1e-8);
+    EXPECT_NEAR(r.clear, c.light == none ? 1.0 : 0.5, 1e-12);
+  }
+  // "seams": false draws none.
+  const Scene plain = load(test::torus_json(R"("look": {"wall_tint": 0, "seams": false})"));
+  MarchParams params;
+  params.max_distance = 3.0;
+  EXPECT_EQ(trace(plain, {2, 0.01, 1}, {1, 0, 0}, 0, params).end.light, Vec3(0.0));
+}
+
+// What the seams read of an edge (DESIGN.md section 1, Appearance), by hand: where its
+// counterclockwise ends lie along it, (-n.y, n.x) with n its outward normal, and what they are.
+// The L-shape's corners are one cone point, the torus's one regular point; the infinite cone of
+// angle pi / 2 has its apex at the finite end of both its ray edges and nothing at infinity.
+TEST(OracleRender, SeamRecordsSayWhereTheCornersAreAndWhichAreConePoints) {
+  const Scene torus = load(test::torus_json());
+  const Scene l_shape = load_scene(std::string(FLATMARCH_SOURCE_DIR) + "/scenes/l_shape.json");
+  const Scene cone = load(R"({"polygons": [[[0, 0], {"to": [1, 0]}, {"to": [0, 1]}]],
+                              "gluings": [[[0, 0], [0, 2]]], "camera": {"position": [1, 1, 1]}})");
+  // The torus [0, 4]^2: bottom along +x, right along +y, top along -x, left along -y.
+  EXPECT_EQ(kernel::seam_record(torus, 0, 0), glm::dvec4(0, 4, 1, 1));
+  EXPECT_EQ(kernel::seam_record(torus, 0, 1), glm::dvec4(0, 4, 1, 1));
+  EXPECT_EQ(kernel::seam_record(torus, 0, 2), glm::dvec4(-4, 0, 1, 1));
+  EXPECT_EQ(kernel::seam_record(torus, 0, 3), glm::dvec4(-4, 0, 1, 1));
+  // The L-shape's edge 3 runs from (4, 2) to (2, 2), along -x.
+  EXPECT_EQ(kernel::seam_record(l_shape, 0, 3), glm::dvec4(-4, -2, 2, 2));
+  for (int e = 0; e < 8; ++e) {
+    EXPECT_EQ(kernel::seam_record(l_shape, 0, e).z, 2.0);
+    EXPECT_EQ(kernel::seam_record(l_shape, 0, e).w, 2.0);
+  }
+  // The cone: edge 0 from the apex out along +x, edge 2 in along -y to the apex.
+  EXPECT_EQ(kernel::seam_record(cone, 0, 0), glm::dvec4(0, 0, 2, 0));
+  EXPECT_EQ(kernel::seam_record(cone, 0, 1), glm::dvec4(0, 0, 0, 0));
+  EXPECT_EQ(kernel::seam_record(cone, 0, 2), glm::dvec4(0, 0, 0, 2));
+  // The compiled tables hold them.
+  const auto tables = kernel::compile_scene<float>(l_shape, MarchParams{});
+  EXPECT_EQ(tables.edges[3].seam, glm::vec4(-4, -2, 2, 2));
+}
+
 // A translation prism's glued floor and ceiling tint too, in the colour one past the gluings'.
 TEST(OracleRender, APrismsGluedCeilingTintsInTheColourAfterTheGluings) {
   const Scene s = load(test::torus_json(

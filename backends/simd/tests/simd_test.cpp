@@ -480,7 +480,15 @@ TEST(Simd, EdgeTablesFindTheNumbersAlikeInEveryRoom) {
     EXPECT_EQ(t.tints.size(), 10u);
     EXPECT_EQ(t.slot_code[9] & 0xffff, 3);  // square 2, edge 1: square 3
     EXPECT_EQ(t.slot_code[10] & 0xffff, 1);
-    EXPECT_EQ(t.tints[static_cast<size_t>(t.slot_code[9] >> 16)], tables.edges[9].tint);
+    EXPECT_EQ(t.tints[static_cast<size_t>((t.slot_code[9] >> 16) & 0xff)], tables.edges[9].tint);
+    // The seams: what each edge's ends are in its code, where they lie by slot (one place).
+    for (size_t e = 0; e < tables.edges.size(); ++e) {
+      EXPECT_EQ((t.slot_code[e] >> 24) & 3, static_cast<int>(tables.edges[e].seam.z));
+      EXPECT_EQ((t.slot_code[e] >> 26) & 3, static_cast<int>(tables.edges[e].seam.w));
+    }
+    EXPECT_TRUE(t.seam_by_slot);
+    EXPECT_EQ(t.slot_seam[0][1], tables.edges[9].seam.x);
+    EXPECT_EQ(t.slot_seam[1][1], tables.edges[9].seam.y);
   }
 }
 
