@@ -214,10 +214,12 @@ void tint_ray(INOUT(Ray) r, vec4 tint, real cosine) {
 // radians: the same pixels wide near and far), drawn whatever crosses the wall, glued or mirror.
 void seam_ray(INOUT(Ray) r, EdgeRecord edge) {
   if (params.seams.x > real(0)) {
-    real kind = seam_kind(r.o, edge.line, edge.seam, real(0.5f) * params.seams.x * r.t, params.top);
+    real half_width = real(0.5f) * params.seams.x * r.t;
+    real kind = seam_kind(r.o, edge.line, edge.seam, half_width, params.top);
     real a = seam_opacity(kind, params.seams);
     vec3 colour = seam_colour(kind, params.seam_colour, params.cone_colour);
-    r.light = tint_light(r.light, r.clear, a, fogged(colour, vec3(params.fog), r.t, params.fog_distance));
+    colour = fogged(colour, vec3(params.fog), r.t, params.fog_distance);
+    r.light = tint_light(r.light, r.clear, a, colour);
     r.clear = r.clear * (real(1) - a);
   }
 }

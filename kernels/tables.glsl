@@ -48,7 +48,8 @@ struct KernelParams {
   vec4 wall;
   vec4 floor_colour;
   vec4 period_tint;  // a translation prism's floor and ceiling, glued: as an edge's tint
-  vec4 seams;        // width per unit of path length (x; 0: no seams), opacity (y), at cone points (z)
+  vec4 seams;        // width per unit of path length (x; 0: no seams), opacity (y), the same at
+                     // cone points (z)
   vec4 seam_colour;  // of a seam at a corner, the top or the bottom of a wall (xyz)
   vec4 cone_colour;  // ... at a cone point's corner (xyz)
 };

@@ -55,7 +55,6 @@ void slot_gluings(const kernel::SceneTables<float>& tables, EdgeTables& t) {
       code.push_back(e.link.y | static_cast<int32_t>(tint - tints.begin()) << 16 |
                      static_cast<int32_t>(e.seam.z) << 24 | static_cast<int32_t>(e.seam.w) << 26);
     }
-
   t.glue_by_slot = true;
   t.slot_code = std::move(code);
   t.tints = std::move(tints);
