@@ -263,9 +263,8 @@ void set_look(const Look& look, typename Tables<real>::KernelParams& params) {
   params.wall = colour(look.wall);
   params.floor_colour = colour(look.floor);
   const Look::Seams& seams = look.seams;
-  const bool on = seams.opacity > 0.0 || seams.cone_opacity > 0.0;
   params.seams =
-      vec4(real(on ? seams.width : 0.0), real(seams.opacity), real(seams.cone_opacity), 0);
+      vec4(real(seams.on() ? seams.width : 0.0), real(seams.opacity), real(seams.cone_opacity), 0);
   params.seam_colour = colour(seams.colour);
   params.cone_colour = colour(seams.cone);
 }

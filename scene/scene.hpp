@@ -201,6 +201,8 @@ struct Look {
     Vec3 colour{0.01, 0.01, 0.012};  // regular corners, the top and the bottom
     Vec3 cone{0.85, 0.35, 0.05};     // cone points
     double cone_opacity = 0.8;
+    // Whether any line is drawn: off when both opacities are 0 (`"seams": false`).
+    bool on() const { return opacity > 0.0 || cone_opacity > 0.0; }
   } seams;
 
   // The colour of gluing k (the floor plan draws the pair in it).

@@ -209,7 +209,7 @@ class Tracer {
   // wall, its top or its bottom, passes a seam first (the kernel's seam_ray).
   void seam(int e, Vec3 at, double t) {
     const Look& look = scene_.look;
-    if (look.seams.opacity <= 0.0 && look.seams.cone_opacity <= 0.0) return;
+    if (!look.seams.on()) return;
     const Edge& edge = scene_.polygons[static_cast<size_t>(p_)].edges[static_cast<size_t>(e)];
     const double top = scene_.period ? *scene_.period : scene_.height;
     const double kind =
