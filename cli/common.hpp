@@ -104,7 +104,7 @@ void write_json(const std::filesystem::path& file, const nlohmann::json& doc);
 // case by case. runtime_error when it cannot be made.
 void make_report_page(const std::string& python, const std::vector<std::string>& results,
                       const std::filesystem::path& out, const std::string& previous);
-// python3 with matplotlib: $FLATMARCH_PYTHON, else /usr/bin/python3.
+// python3 with matplotlib and jinja2: $FLATMARCH_PYTHON, else /usr/bin/python3.
 std::string default_python();
 // The results' regression section: checked against `baseline` (a file; "" for the committed
 // reports/baseline.json when it was measured alike), else "checked" false and why not.

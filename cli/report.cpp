@@ -44,11 +44,11 @@ void make_report_page(const std::string& python, const std::vector<std::string>&
   if (!previous.empty()) command += " --previous " + quoted(previous);
   for (const std::string& r : results) command += " " + quoted(r);
   if (std::system(command.c_str()) != 0)
-    throw std::runtime_error(
-        "the charts and the page could not be made (" + command +
-        " failed; it needs python3 with matplotlib: ci/install-deps.sh installs it); the results "
-        "are in " +
-        results.front());
+    throw std::runtime_error("the charts and the page could not be made (" + command +
+                             " failed; it needs python3 with matplotlib and jinja2: "
+                             "ci/install-deps.sh installs them); the results "
+                             "are in " +
+                             results.front());
 }
 
 namespace {
@@ -191,7 +191,8 @@ void add_report(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--write-baseline", o->write_baseline,
                   "Write this run's deterministic figures as a baseline file");
-  cmd->add_option("--python", o->python, "python3 with matplotlib (env FLATMARCH_PYTHON)")
+  cmd->add_option("--python", o->python,
+                  "python3 with matplotlib and jinja2 (env FLATMARCH_PYTHON)")
       ->capture_default_str();
   cmd->add_option(
       "--shard", o->shard,

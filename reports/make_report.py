@@ -6,8 +6,10 @@
                                                   the same, with the change per case since OLD
     make_report.py -o OUT A.json B.json ...       machines compared: OUT/index.html
 
-The page is self-contained: charts and gallery images are embedded (PNG, base64). Called by
-`flatmarch report`; runs on Debian's python3 with python3-matplotlib.
+The page is self-contained: charts and gallery images are embedded (PNG, base64). Its words and
+layout are the template page.html.j2 beside this script (Jinja); this script draws the charts and
+the tables and hands them to it. Called by `flatmarch report`; runs on Debian's python3 with
+python3-matplotlib and python3-jinja2.
 """
 import argparse
 import base64
@@ -19,6 +21,8 @@ import multiprocessing
 import os
 import sys
 
+import jinja2
+import markupsafe
 import matplotlib
 
 matplotlib.use("Agg")
@@ -109,6 +113,11 @@ def use_registry(all_results):
 
 def esc(text):
     return html.escape(str(text))
+
+
+def html_(text):
+    """Text that is HTML already (a table, a chart), for the template to take as it is."""
+    return markupsafe.Markup(text)
 
 
 def figure_html(fig, alt):
@@ -206,9 +215,7 @@ def summary_section(results, cases):
             continue
         counts[v] += 1
         per.setdefault(c["backend"], {}).setdefault(c["method"], {k: 0 for k in VERDICTS})[v] += 1
-    judged = sum(counts.values())
-    boxes = "".join(f'<div class="count {v}"><b>{counts[v]}</b> {v}</div>' for v in VERDICTS
-                    if v not in ("error",) + UNFINISHED or counts[v])
+    shown = [v for v in VERDICTS if v not in ("error",) + UNFINISHED or counts[v]]
     rows = []
     for b, methods in per.items():
         row = [b]
@@ -218,56 +225,16 @@ def summary_section(results, cases):
                                      if n[v] or v not in ("error",) + UNFINISHED) if n else "-",
                           "bad" if n and any(n[v] for v in BAD) else "limit" if n and n["limit"] else ""))
         rows.append(row)
-    return (f'<h2 id=summary>Verdicts</h2><div class="counts">{boxes}</div>'
-            f'<p>{judged} cases (backend &times; method &times; scene), each measured against the oracle at '
-            f'{esc(results["options"]["conform_size"])} with one set of thresholds. '
-            + "; ".join(f"<b>{v}</b>: {esc(m)}" for v, m in VERDICTS.items()
-                        if v not in UNFINISHED or counts[v])
-            + '. Each case that did not pass is listed with the checks it failed and why in '
-              '<a href="#failures">Failures</a>; the terms are defined in <a href="#definitions">Definitions</a>.</p>'
-            + table(["backend"] + METHODS, rows))
+    meanings = [(v, m) for v, m in VERDICTS.items() if v not in UNFINISHED or counts[v]]
+    return PAGE.summary(results, counts, shown, meanings, html_(table(["backend"] + METHODS, rows)))
 
 
 def definitions_section(results, cases):
-    scenes = results["options"]["scenes"]
-    w, h = (int(v) for v in results["options"]["conform_size"].split("x"))
-    by_type = {}
-    for c in cases:
-        by_type.setdefault(c["surface_type"], set()).add(c["scene"])
-    prisms = sorted(by_type.get("prism", []))
-    failure_rows = [[f, m] for f, m in FAILURE_MEANINGS.items()]
+    prisms = sorted({c["scene"] for c in cases if c["surface_type"] == "prism"})
     check_rows = [[f"<td><code>{esc(k)}</code></td>", v] for k, v in CHECKS.items()]
     check_rows += [[f"<td><code>{esc(k)}REGION</code></td>", v] for k, v in CHECK_PREFIXES.items()]
-    return (
-        "<h2 id=definitions>Definitions</h2>"
-        f"<p><b>Conformance frame</b>: each case renders its scene from the scene's own camera at "
-        f"{w}&times;{h} = {w * h} pixels, with the method's parameters; the oracle renders the same frame "
-        f"exactly. The scenes: {esc(', '.join(scenes))}.</p>"
-        "<p><b>Ambiguity mask, decided pixels</b>: a marching kernel does not follow the exact ray: sphere "
-        "tracing stops within eps of an edge and pushes the point offset into the next room, and every method "
-        "rounds. The mask (conformance/ambiguity.hpp) marks a pixel <i>undecided</i> when its exact ray passes "
-        "within that drift of a vertex or of an edge it does not cross, meets an edge near the top or bottom "
-        "of the wall band, grazes an object's silhouette or crease, or ends near max_distance: there either "
-        "answer is right. The rest are the <b>decided pixels</b>. The mask depends on the scene, the method "
-        "(its push) and the precision, not on the backend.</p>"
-        f"<p><b>Ambiguous share</b> = undecided pixels / all {w * h} pixels of a case's conformance frame, per "
-        "scene and method (table in <a href=\"#ambiguity\">Ambiguity</a>). In translation prisms "
-        f"({esc(', '.join(prisms)) or 'none in this run'}) rays run long and cross many edges, so the share is "
-        "largest there: a case is then judged on a part of its frame only.</p>"
-        "<p><b>Hit wrong</b> (the charts' error axis) = 1 - hit_rate: decided pixels whose hit differs from "
-        "the oracle's / decided pixels of the case's conformance frame.</p>"
-        "<p><b>Failure classes</b>: how a ray that disagrees with the oracle's went wrong "
-        "(conformance/compare.hpp). Counted over (1) the decided pixels of each case's conformance frame "
-        "whose hit or crossings differ from the oracle's: each such pixel is one ray of one class, and the "
-        "check <code>failures.CLASS</code> is their number / the decided pixels; and (2) the suite's probe "
-        "rays (nearly horizontal rays from random points, kept only when their exact path stays clear of "
-        "every vertex), one for each whose events diverge from the oracle's. The Failures table sums both "
-        "over the scenes of this run, per backend and method.</p>"
-        + table(["failure class", "the ray"], failure_rows)
-        + "<p><b>Checks</b>: a case passes when each is within its threshold "
-          "(conformance/thresholds.json). A failed check is shown as <code>name value &lt; limit</code> "
-          "(at least) or <code>name value &gt; limit</code> (at most).</p>"
-        + table(["check", "measures"], check_rows))
+    return PAGE.definitions(results, prisms, html_(table(["failure class", "the ray"], FAILURE_MEANINGS.items())),
+                            html_(table(["check", "measures"], check_rows)))
 
 
 def ambiguity_section(cases):
@@ -307,46 +274,28 @@ def ambiguity_section(cases):
              for s in scenes if (s, m) in shares]
         means.append(pct(sum(v) / len(v)) if v else "-")
     rows.append(means)
-    return ("<h2 id=ambiguity>Ambiguity: the share of each frame left undecided</h2>"
-            f"<p>Undecided pixels / all pixels of the conformance frame, per scene and method, as the "
-            f"{esc(', '.join(sorted(first_backends)))} backend measured it (the first backend that measured the "
-            "pair; a backend whose share differs is named in the cell: the mask depends on the method and the "
-            "precision, not the backend). Shaded: above issue 22's goal for the method, at most 5% for the "
-            "analytic method on every scene and 12% for sphere and relaxed tracing outside prisms.</p>"
-            + table(["scene", "surface type"] + methods, rows))
+    return PAGE.ambiguity(sorted(first_backends), html_(table(["scene", "surface type"] + methods, rows)))
 
 
 def ranking_section(results):
     rec = results.get("recommendation", {})
-    parts = ["<h2 id=ranking>Ranking on this machine and recommended parameters</h2>"]
-    if rec.get("backend"):
-        parts.append(f'<p class="choice">Use <b>{esc(rec["backend"])}</b> with the <b>{esc(rec["method"])}</b> '
-                     f'method: {mrays(rec.get("rays_per_s", 0))} Mrays/s, geometric mean over the gallery. '
-                     f'{esc(rec["why"][0].upper() + rec["why"][1:])}. <code>flatmarch select</code> prints this choice.'
-                     + (" The analytic method crosses edges exactly and pushes no point: it does not use the offset."
-                        if rec["method"] == "analytic" else "") + "</p>")
-        rows = []
-        for t, p in rec.get("parameters", {}).items():
-            if p["source"] == "sweep":
-                src = "the sweep's recommendation" + (", re-checked at " + p["confirmed"]["size"]
-                                                      if p.get("confirmed") else "")
-                if p.get("fallback"):
-                    src = "<b>fallback</b>: " + src + ", a stable point none of whose eps neighbours is stable"
-            else:
-                src = (f'<b>fallback</b>, the defaults: no point of the sweep passes with {esc(rec["method"])} on '
-                       f'every {esc(t)} scene')
-                stable = p.get("stable_methods", [])
-                src += ("; stable there, use instead: " + ", ".join(
-                    f'<b>{esc(m["method"])}</b> (eps {m["eps"]:g}, offset {m["offset"]:g})' for m in stable)
-                        if stable else "; no method is stable there")
-            rows.append((t, f'{p["eps"]:g}', f'{p["offset"]:g}',
-                         f'<td class="{"limit" if p.get("fallback") else ""}">{src}</td>'))
-        opts = results.get("options", {})
-        parts.append(table(["surface type", "eps", "offset", "from"], rows) if rows else
-                     f'<p>No sweep in this run, so no eps and offset per surface type: every figure is at the '
-                     f'run\'s eps {opts.get("eps", 0):g} and offset {opts.get("offset", 0):g}.</p>')
-    else:
-        parts.append(f'<p class="bad">No recommendation: {esc(rec.get("why", ""))}</p>')
+    rows = []
+    for t, p in rec.get("parameters", {}).items() if rec.get("backend") else []:
+        if p["source"] == "sweep":
+            src = "the sweep's recommendation" + (", re-checked at " + p["confirmed"]["size"]
+                                                  if p.get("confirmed") else "")
+            if p.get("fallback"):
+                src = "<b>fallback</b>: " + src + ", a stable point none of whose eps neighbours is stable"
+        else:
+            src = (f'<b>fallback</b>, the defaults: no point of the sweep passes with {esc(rec["method"])} on '
+                   f'every {esc(t)} scene')
+            stable = p.get("stable_methods", [])
+            src += ("; stable there, use instead: " + ", ".join(
+                f'<b>{esc(m["method"])}</b> (eps {m["eps"]:g}, offset {m["offset"]:g})' for m in stable)
+                    if stable else "; no method is stable there")
+        rows.append((t, f'{p["eps"]:g}', f'{p["offset"]:g}',
+                     f'<td class="{"limit" if p.get("fallback") else ""}">{src}</td>'))
+    parameters = html_(table(["surface type", "eps", "offset", "from"], rows)) if rows else ""
     methods = METHODS
     rows = []
     for b in results.get("ranking", []):
@@ -364,24 +313,9 @@ def ranking_section(results):
                        if mm else "-")
         row.append(b["best_method"] or "-")
         rows.append(row)
-    parts.append("<p>Backends ranked: those that passed every conformance case first, then by the geometric "
-                 "mean of rays per second over every scene and method; a case at its method's limit is no pass. "
-                 "Per method: Mrays/s (cases passed; for the "
-                 "SIMD backend, the geometric means of how much of this CPU's peak its frames reach and of its lane "
-                 "efficiency: what one thread of it does over what the scalar backend's thread does, over its "
-                 "lanes, see Steps). "
-                 "A GPU backend names the device it ran on; <i>software</i> marks a rasteriser running on the "
-                 "CPU (Mesa's llvmpipe and lavapipe, Chromium's SwiftShader), whose speed says nothing of a GPU's.</p>")
-    parts.append(table(["rank", "backend", "device", "Mrays/s", "verdicts"] + [f"{m} Mrays/s" for m in methods] +
-                       ["fastest conforming method"], rows))
-    skipped = results.get("matrix", {}).get("skipped", [])
-    if skipped:
-        parts.append("<p>Skipped: " + "; ".join(f'{esc(s["backend"])} ({esc(s["reason"])})' for s in skipped) + "</p>")
-    for s in results.get("matrix", {}).get("sampled", []):
-        parts.append(f'<p class="sampled">Measured on a sample: {esc(s["backend"])}, on '
-                     f'{len(s["cases"])} of {s["of_cases"]} cases ({esc(", ".join(s["cases"]))}), '
-                     f'because {esc(s["why"])}. Its figures are of those scenes alone.</p>')
-    return "\n".join(parts)
+    ranked = table(["rank", "backend", "device", "Mrays/s", "verdicts"] + [f"{m} Mrays/s" for m in methods] +
+                   ["fastest conforming method"], rows)
+    return PAGE.ranking(results, rec, parameters, html_(ranked), "")
 
 
 def device_time_section(results, cases):
@@ -391,16 +325,6 @@ def device_time_section(results, cases):
                       not c.get("counters", {}).get("device_ms")})
     if not ranked and not missing:
         return ""
-    parts = ["<h2 id=device>Time on the device</h2>",
-             "<p>A GPU backend's frame timed twice: by the clock around it (the wall time, what a user waits for "
-             "and what the ranking goes by) and by the device's own clock (OpenGL timer queries, Vulkan "
-             "timestamp queries), split into the march (the draws or dispatches), the read-back (the copy of "
-             "the frame to where the host reads it) and the rest (the wall time less the device's: submission, "
-             "waits, the host unpacking the frame). Timed frames read back their 8-bit colour alone. Geometric "
-             "means over the backend's timed cases; shares of the wall time are means. On a software "
-             "rasteriser the clock is the driver's: lavapipe's timestamps bracket its dispatch, llvmpipe "
-             "answers OpenGL's queries when its setup thread passes them, not when its rasteriser threads have "
-             "drawn, so its split says nothing of the work.</p>"]
     rows = []
     for b in ranked:
         d = b["device_time"]
@@ -408,9 +332,8 @@ def device_time_section(results, cases):
         rows.append([b["backend"], device_text(b), shape or "-", d["cases"], f'{d["wall_ms"]:.3g}',
                      f'{d["device_ms"]:.3g}', pct(d["march_share"]), pct(d["readback_share"]),
                      pct(d["rest_share"])])
+    figure = ""
     if rows:
-        parts.append(table(["backend", "device", "kernel shape", "cases", "wall ms", "device ms", "march",
-                            "read-back", "rest"], rows))
         fig, ax = plt.subplots(figsize=(7.0, 0.6 + 0.45 * len(ranked)))
         names = [b["backend"] for b in ranked]
         left = [0.0] * len(ranked)
@@ -423,11 +346,10 @@ def device_time_section(results, cases):
         ax.set_xlim(0, 100)
         ax.invert_yaxis()
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
-        parts.append(figure_html(fig, "each GPU backend's frame split by the device's clock"))
-    if missing:
-        parts.append("<p>No device time for " + ", ".join(esc(m) for m in missing) +
-                     ": its device has no clock (the benchmark's label says why).</p>")
-    return "\n".join(parts)
+        figure = figure_html(fig, "each GPU backend's frame split by the device's clock")
+    return PAGE.device_time(html_(table(["backend", "device", "kernel shape", "cases", "wall ms", "device ms",
+                                         "march", "read-back", "rest"], rows)) if rows else "",
+                            html_(figure), missing)
 
 
 def left_out_note(results):
@@ -435,15 +357,9 @@ def left_out_note(results):
     left = results.get("left_out")
     if not left:
         return ""
-    drawn = left.get("drawn_by_merge")
     what = ", ".join("Yee's perceptual check" if w == "image.perceptual_failpercent" else
                      "each backend's frames and the recommended gallery" for w in left.get("what", []))
-    return (f'<p class="limit">Measured without the image library ({esc(left.get("why", "").splitlines()[0])}): '
-            f'left out, {esc(what)}; every other figure is measured, and the verdicts are the other checks\'.'
-            + (" The recommended gallery below was drawn afterwards by <code>flatmarch merge</code> on another "
-               "machine, with its backends." if drawn else
-               " <code>flatmarch merge results.json -o DIR/results.json</code> on a machine with OpenImageIO "
-               "draws the recommended gallery and this page.") + "</p>")
+    return PAGE.left_out(left, what)
 
 
 def speed_accuracy_section(cases):
@@ -484,12 +400,7 @@ def speed_accuracy_section(cases):
                 plt.Line2D([], [], color="k", marker="x", ls="", label="fail (crossed)")]
     fig.legend(handles=handles, loc="upper center", ncol=8, bbox_to_anchor=(0.5, 0.0))
     fig.tight_layout()
-    return ("<h2 id=speed>Speed against accuracy, per surface type</h2>"
-            "<p>Each point is one backend, method and gallery scene: its speed (timed frames) against the share "
-            "of pixels the oracle decides whose hit or crossing count is wrong (mean of the two; zero is drawn "
-            "on the bottom line). Filled: the case passes; hollow: at its method's limit; hollow and crossed: it "
-            "fails. Up and to the left is worse.</p>"
-            + figure_html(fig, "speed against accuracy"))
+    return PAGE.speed_accuracy(html_(figure_html(fig, "speed against accuracy")))
 
 
 def gallery_section(results, images):
@@ -507,13 +418,7 @@ def gallery_section(results, images):
             cells.append("<td>" + image_html(os.path.join(images, b, s + ".png"), f"{s}, {b}")
                          + (f"<br>{verdict_html(v)}" if v else "") + "</td>")
         rows.append(cells)
-    return ("<h2 id=gallery>Gallery, per backend</h2><p>Each scene from its own camera, by the exact oracle "
-            f"and by each backend with the {esc(method)} method ({esc(results['options']['size'])}, the timed "
-            "frames), with each case's verdict. A ray that runs out of steps is shaded as fog (the grey haze "
-            "sphere tracing leaves in translation prisms): such a case is at its method's limit, not a pass. "
-            "The recommended method's images, with their differences from the oracle, are in "
-            "<a href=\"#recommended\">the recommended choice</a>.</p>"
-            + table(["scene"] + backends, rows, "gallery"))
+    return PAGE.gallery(results, method, html_(table(["scene"] + backends, rows, "gallery")))
 
 
 def recommended_gallery_section(results, images):
@@ -521,11 +426,8 @@ def recommended_gallery_section(results, images):
     if not g:
         why = ("no backend passed every case of any method here, so nothing is recommended"
                if not results.get("recommendation", {}).get("backend") else "these results have no gallery")
-        return f"<h2 id=recommended>The recommended choice, scene by scene</h2><p>No images: {esc(why)}.</p>"
-    legend = "<ul class=legend>" + "".join(
-        f'<li><span class="swatch" style="background:{esc(e["colour"])}"></span><b>{esc(e["name"])}</b>: '
-        f'{esc(e["meaning"])}</li>' for e in VOCABULARY["pixel_classes"]
-        if e["name"] != "agree" and not e["traces_only"]) + "</ul>"
+        return PAGE.recommended(g, why, {}, [], "")
+    legend = [e for e in VOCABULARY["pixel_classes"] if e["name"] != "agree" and not e["traces_only"]]
     colour_name = {e["name"]: e["colour_name"] for e in VOCABULARY["pixel_classes"]}
     rows = []
     for sc in g["scenes"]:
@@ -545,16 +447,9 @@ def recommended_gallery_section(results, images):
                      f'<td>eps {sc["eps"]:g}, offset {sc["offset"]:g}<br>'
                      f'{pct(wrong / decided) if decided else "-"} of the decided pixels differ<br>'
                      f'<small>{"; ".join(differ) or "no pixel differs"} (of all {pixels})</small></td>'])
-    return ("<h2 id=recommended>The recommended choice, scene by scene</h2>"
-            f'<p>Each scene rendered by the recommended <b>{esc(g["backend"])}</b> backend with the '
-            f'<b>{esc(g["method"])}</b> method ({esc(g["size"])}) at the eps and offset recommended for its surface '
-            "type, beside the oracle's image and a map of where the two differ. In the map, pixels that agree "
-            "show the oracle's image dimmed; a ray whose hit or crossings differ from the oracle's is painted by "
-            "its failure class, one whose hit and crossings agree but whose colour differs in "
-            f'{esc(colour_name["colour"])}, and a pixel the ambiguity mask leaves undecided in '
-            f'{esc(colour_name["ambiguous"])}:</p>' + legend
-            + table(["scene", "oracle", f'{g["backend"]}, {g["method"]}', "difference", "parameters and pixels"],
-                    rows, "gallery recommended"))
+    return PAGE.recommended(g, "", colour_name, legend, html_(table(
+        ["scene", "oracle", f'{g["backend"]}, {g["method"]}', "difference", "parameters and pixels"], rows,
+        "gallery recommended")))
 
 
 def number(v):
@@ -565,30 +460,8 @@ def regression_section(results):
     """The regression gate's verdict on this run's figures (results["regression"], written by
     `flatmarch report`)."""
     r = results.get("regression")
-    out = ["<h2 id=regression>Regression gate</h2>"]
-    if not r:
-        return out[0] + "<p>Not checked: these results were written before the report stored the gate's verdict.</p>"
-    if not r["checked"]:
-        against = f' against {esc(r["baseline"])}' if r.get("baseline") else ""
-        return out[0] + (f'<p class="verdict-line">Not checked{against}: {esc(r["why"])}. The gate compares only '
-                         "runs measured alike: <code>reports/gate.sh</code> measures as the committed baseline was "
-                         "measured.</p>")
-    regressions, improvements = r["regressions"], r["improvements"]
-    ok = not regressions
-    source = ("the baseline given with --baseline" if r.get("given")
-              else "the committed baseline, as this run was measured alike")
-    out.append(f'<p class="verdict-line">Gate: {verdict_html("pass" if ok else "fail")} '
-               f'{r["compared"]} cases compared with {esc(r["baseline"])} ({source}, measured '
-               f'{esc(r.get("baseline_created", "?"))}): <b>{len(regressions)} regressions</b>, {len(improvements)} '
-               f'improvements, {len(r["timing_warnings"])} timing warnings, {len(r["missing"])} of the baseline\'s '
-               f'{r.get("baseline_cases", "?")} cases not measured in this run.</p>')
-    tol = r.get("tolerances", {})
-    out.append("<p>A deterministic figure (steps, crossings, conformance rates) regresses when it is worse than the "
-               "baseline's by more than its tolerance, abs + rel &times; the baseline's value; a case that passed "
-               "and no longer does, or that was at its method's limit and now fails, regresses too. Timings "
-               "only warn (Mann-Whitney U over the repetitions, p &lt; 0.05, median slower by more than 10%). "
-               "Tolerances: " + ", ".join(f'{esc(k)} {v["abs"]:g} + {v["rel"]:g}&times;' for k, v in tol.items())
-               + ".</p>")
+    if not r or not r["checked"]:
+        return PAGE.regression(r, "", "", "", "")
 
     def rows_of(entries):
         rows = []
@@ -601,21 +474,15 @@ def regression_section(results):
                          number(g["tolerance"]) if "tolerance" in g else "-", f"<td>{extra}</td>"])
         return rows
     header = ["case", "figure", "baseline", "now", "change", "tolerance", "failed checks now"]
-    if regressions:
-        out.append("<h3>Regressions</h3>" + table(header, rows_of(regressions), "regressions"))
-    if improvements:
-        out.append(f"<details><summary>{len(improvements)} improvements beyond tolerance (update the baseline on "
-                   "purpose: <code>reports/gate.sh --write</code>)</summary>" + table(header, rows_of(improvements))
-                   + "</details>")
-    if r["timing_warnings"]:
-        out.append(f'<details><summary>{len(r["timing_warnings"])} cases slower than the baseline (informative: '
-                   "a busy machine slows every case)</summary>" + table(
-                       ["case", "baseline ms", "now ms", "ratio", "p"],
-                       [[w["case"], f'{w["was_ms"]:.3g}', f'{w["now_ms"]:.3g}', f'{w["ratio"]:.2f}',
-                         f'{w["p_value"]:.2g}'] for w in r["timing_warnings"]]) + "</details>")
-        if not r.get("same_machine", True):
-            out.append("<p>The baseline's timings come from another CPU: compare them with care.</p>")
-    return "\n".join(out)
+    source = ("the baseline given with --baseline" if r.get("given")
+              else "the committed baseline, as this run was measured alike")
+    warnings = table(["case", "baseline ms", "now ms", "ratio", "p"],
+                     [[w["case"], f'{w["was_ms"]:.3g}', f'{w["now_ms"]:.3g}', f'{w["ratio"]:.2f}',
+                       f'{w["p_value"]:.2g}'] for w in r["timing_warnings"]])
+    return PAGE.regression(r, source, html_(table(header, rows_of(r["regressions"]), "regressions"))
+                           if r["regressions"] else "",
+                           html_(table(header, rows_of(r["improvements"]))) if r["improvements"] else "",
+                           html_(warnings) if r["timing_warnings"] else "")
 
 
 def previous_section(results, previous, previous_path):
@@ -629,12 +496,6 @@ def previous_section(results, previous, previous_path):
     was = {key(c): c for c in previous.get("matrix", {}).get("cases", [])}
     common = [k for k in now if k in was]
     sizes = [(r.get("options", {}).get("size"), r.get("options", {}).get("conform_size")) for r in (previous, results)]
-    out = [f"<h2 id=previous>Since the earlier run</h2><p>Compared with {esc(previous_path)} (measured "
-           f"{esc(previous.get('created', '?'))}): {len(common)} cases (backend, method, scene) in both, "
-           f"{len(now) - len(common)} new, {len(was) - len(common)} no longer measured."
-           + (f" The earlier run timed frames of {esc(sizes[0][0])} and judged {esc(sizes[0][1])}, this one "
-              f"{esc(sizes[1][0])} and {esc(sizes[1][1])}: compare with care." if sizes[0] != sizes[1] else "")
-           + "</p>"]
     # Worse the later in the vocabulary's order (pass, limit, fail, error, then the unfinished).
     rank = {v: k for k, v in enumerate(VERDICTS)} | {None: -1}
     changed = [(n, verdict(was[n]), verdict(now[n])) for n in common if verdict(was[n]) != verdict(now[n])]
@@ -647,10 +508,7 @@ def previous_section(results, previous, previous_path):
             rows.append([now[n]["name"], f"<td>{verdict_html(before or 'not judged')}</td>",
                          f"<td>{verdict_html(after or 'not judged')}</td>",
                          "worse" if rank[after] > rank[before] else "better", f"<td>{why}</td>"])
-        out.append("<h3>Verdicts that changed</h3>" +
-                   table(["case", "before", "now", "", "failed checks now"], rows, "reasons"))
-    else:
-        out.append("<p>No verdict changed.</p>")
+    changed = table(["case", "before", "now", "", "failed checks now"], rows, "reasons") if changed else ""
     same_cpu = previous.get("fingerprint", {}).get("cpu") == results.get("fingerprint", {}).get("cpu")
     rows = []
     for n in common:
@@ -672,16 +530,11 @@ def previous_section(results, previous, previous_path):
         if abs(v) < 5e-6:
             return "0"
         return td(f"{100 * v:+.3g} pp", "bad" if v > 1e-4 else "good" if v < -1e-4 else "")
-    out.append("<h3>Figures that changed</h3><p>Per case in both runs, where the share of decided pixels whose hit "
-               "is wrong or the ambiguous share moved by more than 0.01 percentage points, or the speed by more "
-               "than 10%: largest hit change first. Speed is this run's rays per second over the earlier run's"
-               + ("" if same_cpu else ", measured on another CPU: compare with care") + ".</p>")
-    if rows:
-        out.append(table(["case", "hit wrong", "ambiguous", "speed"],
-                         [[now[n]["name"], delta(h), delta(a), f"{s:.3g}x" if s else "-"] for n, h, a, s in rows]))
-    else:
-        out.append("<p>No figure moved beyond these bounds.</p>")
-    return "\n".join(out)
+    figures = table(["case", "hit wrong", "ambiguous", "speed"],
+                    [[now[n]["name"], delta(h), delta(a), f"{s:.3g}x" if s else "-"] for n, h, a, s in rows]) \
+        if rows else ""
+    return PAGE.previous(previous, previous_path, len(common), len(now) - len(common), len(was) - len(common),
+                         sizes, html_(changed), html_(figures), same_cpu)
 
 
 def steps_heatmap_section(cases):
@@ -730,19 +583,9 @@ def steps_heatmap_section(cases):
             if e is not None:
                 text += f' · {pct(e)} of {int(counters["lanes"])} lanes'
             return text
-        lane_table = ("<p>SIMD lane utilisation: the share of packet lanes doing work, over every step of every "
-                      "packet (rays of a packet that finish early, or step apart, leave lanes idle); and how close "
-                      "to what this CPU can do the frame runs: its kernel steps a second over the peak, the steps a "
-                      "second of one room's step on full packets on every core (no lane idle, nothing to shade or "
-                      "write, the tables in cache); and its lane efficiency: one thread's rays a second over the "
-                      "scalar backend's (one thread too), over the lanes of the instruction set it ran, so "
-                      "<i>x% of 16 lanes</i> is x% of what these lanes could do if each ran the scalar backend's "
-                      "ray as fast (where the run has the scalar backend's case too).</p>" +
-                      table(["scene"] + methods,
-                            [[s] + [cell((s, m)) if (s, m) in simd else "-" for m in methods] for s in scenes]))
-    return ("<h2 id=steps>Steps per ray</h2><p>The mean number of kernel iterations per ray of the timed frames, per "
-            "scene, backend and method: the cost the backends share; backends of one method should agree.</p>"
-            + figure_html(fig, "steps heatmap") + lane_table)
+        lane_table = table(["scene"] + methods,
+                           [[s] + [cell((s, m)) if (s, m) in simd else "-" for m in methods] for s in scenes])
+    return PAGE.steps(html_(figure_html(fig, "steps heatmap")), html_(lane_table))
 
 
 def unfinished_section(results):
@@ -756,11 +599,7 @@ def unfinished_section(results):
         tail = [line for line in u.get("stderr_tail", "").splitlines() if line.strip()][-6:]
         rows.append([u["key"], f"<td>{verdict_html(u['verdict'])}</td>", u["error"],
                      "<td><pre>" + esc("\n".join(tail)) + "</pre></td>" if tail else "-"])
-    return ("<h2 id=unfinished>Cases that did not finish</h2><p>Each case ran in a watched worker process; "
-            "these ended it (the run went on in a fresh worker). A matrix case among them counts as an error "
-            "of its backend in the ranking and as a regression at the gate; a sweep group or scaling series "
-            "is missing from its chart.</p>"
-            + table(["case", "verdict", "what ended it", "its worker's last words"], rows))
+    return PAGE.unfinished(html_(table(["case", "verdict", "what ended it", "its worker's last words"], rows)))
 
 
 def failure_section(cases):
@@ -780,13 +619,8 @@ def failure_section(cases):
         rows.append([b, m, t["cases"], t["pass"], td(t["limit"], "limit" if t["limit"] else ""),
                      td(sum(t[v] for v in BAD), "bad" if any(t[v] for v in BAD) else "")] +
                     [td(t[f], "bad" if t[f] else "") for f in FAILURES])
-    out = ["<h2 id=failures>Failures</h2><p>Per backend and method: the cases of each verdict, and the rays of "
-           "each failure class summed over the scenes (decided pixels of the conformance frames and diverging "
-           "probe rays; see <a href=\"#definitions\">Definitions</a>). Then each case that did not pass, with "
-           "every check it failed: its measured value against the threshold, and what the check measures (the "
-           "backends whose cases read alike share a row).</p>",
-           table(["backend", "method", "cases", "pass", "limit", "fail, error or unfinished"] + FAILURES,
-                 rows)]
+    totals_table = table(["backend", "method", "cases", "pass", "limit", "fail, error or unfinished"] + FAILURES,
+                         rows)
     order = {v: 0 for v in BAD} | {"limit": 1}
     bad = sorted((c for c in cases if verdict(c) in order),
                  key=lambda c: (order[verdict(c)], c["scene"], c["method"], c["backend"]))
@@ -809,12 +643,9 @@ def failure_section(cases):
         rows.append([f'<td data-cases="{esc(names)}">{esc(scene)} &middot; {esc(method)}<br>'
                      f'<small>{esc(", ".join(c["backend"] for c in group))} ({esc(group[0]["name"].split("/")[-1])})'
                      "</small></td>", f"<td>{verdict_html(v)}</td>", "<td>" + "<br>".join(lines) + "</td>"])
-    if rows:
-        out.append(table(["scene · method (backends)", "verdict", "why: each failed check"], rows,
-                         "reasons"))
-    else:
-        out.append("<p class=good>Every case passed its thresholds.</p>")
-    return "\n".join(out)
+    reasons = table(["scene · method (backends)", "verdict", "why: each failed check"], rows, "reasons") \
+        if rows else ""
+    return PAGE.failures(html_(totals_table), html_(reasons))
 
 
 def sweep_section(sweep):
@@ -824,36 +655,12 @@ def sweep_section(sweep):
     opts = sweep["options"]
     labels = opts["offset_labels"]
     eps_values = sorted(opts["eps"], reverse=True)
-    confirm = opts.get("confirm_size")
     codes = sorted({c.get("cause", "") for g in analysis for c in g["grid"] if not c["stable"]} - {""},
                    key=lambda k: list(CAUSE_CODES).index(k) if k in CAUSE_CODES else len(CAUSE_CODES))
     legend = table(["code", "what made the point unstable"],
                    [[f"<td><b>{esc(CAUSE_CODES.get(k, k[:3]))}</b></td>", f"{k}: {CAUSE_MEANINGS.get(k, '')}"]
                     for k in codes])
-    out = [f"<h2 id=sweep>eps &times; offset sweep</h2><p>The {esc(opts['backend'])} backend at {esc(opts['size'])} "
-           f"({opts['repetitions']} timed frames a point) over hit thresholds eps and re-entry offsets (multiples of "
-           "eps, and fixed values), each point judged by the conformance suite against one truth (the oracle, "
-           "masked as for the default parameters). A point is <b>stable</b> when its verdict is <b>pass</b> on "
-           "every swept scene of the surface type: no check is left out, and a point at its method's limit is "
-           "not stable.</p>"
-           "<p><b>Stability</b> heatmaps: the colour is the share of decided pixels whose hit is wrong (mean over "
-           "the type's scenes, log); a tick marks a stable point; an unstable point shows what made it "
-           "unstable: the failure class whose threshold the most scenes fail, else (when the hit, crossings or "
-           "trace agreement fails) the class with the most rays, else the check the most scenes fail, as a code "
-           "(legend below) in white where a scene fails and in yellow where every scene that does not pass is "
-           "at the method's limit. The star is the recommendation: of the stable points whose neighbours a "
-           "decade of eps either side are stable too, one within 10% of the fewest mean steps with the most "
-           "stable neighbours on the grid; an orange star is a <b>fallback</b>, a stable point none of whose eps "
-           "neighbours is stable. <b>Steps</b> heatmaps: mean kernel steps per ray. The Pareto chart: each grid "
-           "point's time against its error; the front joins the points no other beats on both.</p>"
-           "<p><b>Not noise.</b> Stability is the conformance verdict, which does not depend on timing, and "
-           "the choice among stable points is by mean steps, which every run measures alike. What small "
-           "frames can change is the verdict itself (a few rays more or less near a threshold), so "
-           + (f"each recommended point was rendered again at {esc(confirm)} on every swept scene of its type, "
-              "and a point that failed there was dropped and the next one chosen (code rc); the table says "
-              "which points were re-checked."
-              if confirm else "these results, written without a re-check at a larger size, may hold a point "
-              "that passes only at this size.") + "</p>" + legend]
+    out = []
     rec_rows = []
     no_stable = {}  # (surface type, method, why) -> the precisions with no stable point
     types = [t for t in SURFACE_TYPES if any(g["surface_type"] == t for g in analysis)]
@@ -968,14 +775,10 @@ def sweep_section(sweep):
                              f'<td class="bad">nothing stable{f": mostly {esc(top)}" if top else ""}</td>', "-",
                              f"<td>{advice}</td>"])
             why = f'no point of the grid passes on every scene{f" (most often: {esc(top)})" if top else ""}; ' + advice
-            no_stable.setdefault((t, g["method"], why), []).append(g["precision"])
-    out.insert(1, table(["surface type", "method", "precision", "stable points", "eps", "offset", "at",
-                         "re-check", "note"], rec_rows))
-    if no_stable:
-        out.insert(2, '<p class="bad">Where no point is stable:</p><ul>' + "".join(
-            f'<li><b>{esc(m)}</b> ({esc(", ".join(precisions))}) on {esc(t)} surfaces: {why}.</li>'
-            for (t, m, why), precisions in no_stable.items()) + "</ul>")
-    return "\n".join(out)
+            no_stable.setdefault((t, g["method"], html_(why)), []).append(g["precision"])
+    recommendations = table(["surface type", "method", "precision", "stable points", "eps", "offset", "at",
+                             "re-check", "note"], rec_rows)
+    return PAGE.sweep(opts, html_(recommendations), no_stable, html_(legend), html_("\n".join(out)))
 
 
 def scaling_section(scaling):
@@ -1007,37 +810,18 @@ def scaling_section(scaling):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
     fig.tight_layout()
-    return ("<h2 id=scaling>Scaling</h2><p>Time per frame against pixels (the gallery torus), against the "
-            "number of edges (regular 2n-gons, solid; staircases of squares, each its own room, dashed; both "
-            "empty translation prisms where every ray runs the same distance) and against the path length "
-            "(an empty torus prism, where every ray runs max_distance). The slope is the exponent of a power-law "
-            "fit: 1 is linear. The SIMD backend's lanes idle when the rays of a packet are in different rooms: the last "
-            "column shows the share of its lanes at work at each point of a series.</p>" + figure_html(fig, "scaling") +
-            table(["axis", "family", "backend", "method", "time slope", "steps slope", "x", "ms", "SIMD lanes busy, per point"],
-                  rows))
+    return PAGE.scaling(html_(figure_html(fig, "scaling")), html_(table(
+        ["axis", "family", "backend", "method", "time slope", "steps slope", "x", "ms", "SIMD lanes busy, per point"],
+        rows)))
 
 
-PAGE = """<!doctype html><html><head><meta charset="utf-8"><title>{title}</title><style>
-body {{ font-family: sans-serif; margin: 1.5em auto; max-width: 1500px; color: #222; }}
-table {{ border-collapse: collapse; margin: 0.6em 0; font-size: 0.85em; }}
-th, td {{ border: 1px solid #ccc; padding: 3px 6px; text-align: left; vertical-align: top; }}
-th {{ background: #eee; }} td.bad {{ background: #fdd; }} .bad {{ color: #a00; }} .good {{ color: #070; }}
-td.limit, td.warn {{ background: #fff1c8; }}
-img.chart {{ max-width: 100%; display: block; margin: 0.5em 0; }} img.frame {{ width: 200px; }}
-.choice {{ font-size: 1.1em; background: #eef6ff; padding: 0.6em; }} nav a {{ margin-right: 1em; }}
-.counts {{ display: flex; gap: 0.8em; margin: 0.6em 0; }}
-.count {{ padding: 0.4em 1em; border-radius: 4px; font-size: 1.2em; border: 1px solid #ccc; }}
-.count b {{ font-size: 1.4em; }} .count.pass {{ background: #dff3df; }} .count.limit {{ background: #fff1c8; }}
-.count.fail, .count.error, .count.crash, .count.timeout, .count.out_of_memory {{ background: #fdd; }}
-.verdict {{ padding: 0 0.4em; border-radius: 3px; font-weight: bold; font-size: 0.9em; }}
-.verdict.pass {{ background: #dff3df; color: #060; }} .verdict.limit {{ background: #fff1c8; color: #750; }}
-.verdict.fail, .verdict.error, .verdict.crash, .verdict.timeout, .verdict.out_of_memory {{
-  background: #fdd; color: #a00; }}
-.verdict-line {{ font-size: 1.05em; }} table.reasons td {{ max-width: 900px; }}
-table.recommended img.frame {{ width: 320px; }} ul.legend {{ columns: 2; margin: 0.3em 0; }}
-.swatch {{ display: inline-block; width: 0.9em; height: 0.9em; border: 1px solid #555; margin: 0 0.25em;
-  vertical-align: middle; }}
-</style></head><body>{body}</body></html>"""
+# The page's template, beside this script (a link to it in the build tree, installed beside it).
+_TEMPLATES = jinja2.Environment(
+    loader=jinja2.FileSystemLoader(os.path.dirname(os.path.abspath(__file__))), autoescape=True,
+    undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True)
+_TEMPLATES.filters["verdict"] = lambda v: html_(verdict_html(v))
+_TEMPLATES.filters["mrays"] = lambda v: mrays(v)
+PAGE = _TEMPLATES.get_template("page.html.j2").module
 
 
 # The sections a forked worker draws: (function, arguments) by index, set before the pool forks.
@@ -1080,15 +864,11 @@ def one_machine(results, images, previous=None, previous_path=""):
              ("definitions", "definitions", definitions_section, (results, cases)),
              ("machine", "machine", machine_section, (results,))]
     drawn = draw_sections([(function, arguments) for _, _, function, arguments in named])
-    sections = [(anchor, title, html_) for (anchor, title, _, _), html_ in zip(named, drawn)]
-    body = [f"<h1>flatmarch report</h1><p>Measured {esc(results.get('created'))}: timed frames "
-            f"{esc(results['options']['size'])} (median of {results['options']['repetitions']} repetitions, "
-            f"Google Benchmark), conformance frames {esc(results['options']['conform_size'])}, eps "
-            f"{results['options']['eps']:g}, offset {results['options']['offset']:g}.</p>",
-            shards_note(results), left_out_note(results),
-            "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t, html_ in sections if html_) + "</nav>"]
-    body += [html_ for _, _, html_ in sections if html_]
-    return PAGE.format(title="flatmarch report", body="\n".join(body))
+    sections = [(anchor, title, text) for (anchor, title, _, _), text in zip(named, drawn)]
+    body = [PAGE.header(results), shards_note(results), left_out_note(results),
+            "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t, text in sections if text) + "</nav>"]
+    body += [text for _, _, text in sections if text]
+    return PAGE.page("flatmarch report", html_("\n".join(body)))
 
 
 def machine_section(results):
@@ -1100,14 +880,10 @@ def shards_note(results):
     shards = results.get("shards")
     if not shards:
         return ""
-    hosts = ", ".join(esc(h) for h in results.get("hosts", []) if h) or "one host"
-    rows = [[str(k + 1), esc(s.get("host", "")), f"{sum(s.get('seconds', {}).values()):.0f} s",
+    hosts = ", ".join(h for h in results.get("hosts", []) if h) or "one host"
+    rows = [[str(k + 1), s.get("host", ""), f"{sum(s.get('seconds', {}).values()):.0f} s",
              f"{s.get('expected_seconds', 0):.0f} s"] for k, s in enumerate(shards)]
-    return (f"<p>Merged by <code>flatmarch merge</code> from {len(shards)} shards "
-            f"(<code>--shard I/{len(shards)}</code>) measured on {hosts}; the ranking, the "
-            "recommendation, the sweep's analysis and the gallery were made from all of them.</p>"
-            "<details><summary>Each shard's time against its estimate</summary>"
-            + table(["shard", "host", "measured", "estimated"], rows) + "</details>")
+    return PAGE.shards(results, hosts, html_(table(["shard", "host", "measured", "estimated"], rows)))
 
 
 # --- Machines compared.
@@ -1126,10 +902,9 @@ def gpu_text(fp):
 
 
 def machines(all_results, names):
-    body = ["<h1>flatmarch: machines compared</h1>"]
     each = [dict(fingerprint_rows(r)) for r in all_results]
     rows = [[label] + [e.get(label, "") for e in each] for label, _ in fingerprint_rows(all_results[0])]
-    body.append(table(["", *names], rows))
+    machine_table = table(["", *names], rows)
     backends = sorted({b["backend"] for r in all_results for b in r.get("ranking", [])})
     fig, ax = plt.subplots(figsize=(2 + 1.6 * len(backends), 4.5))
     width = 0.8 / len(all_results)
@@ -1154,14 +929,14 @@ def machines(all_results, names):
     ax.set_ylim(bottom, top * 30)  # room for the device names above the bars
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=1)
     ax.grid(True, axis="y", which="both", alpha=0.3)
-    body.append("<h2>Speed per backend</h2>" + figure_html(fig, "speed per machine"))
+    speed = figure_html(fig, "speed per machine")
     rows = []
     for r, name in zip(all_results, names):
         rec = r.get("recommendation", {})
         order = ", ".join(f'{b["rank"]}. {b["backend"]} on {device_text(b)} ({mrays(b["rays_per_s"])}, '
                           f'{b["passed"]}/{b["cases"]})' for b in r.get("ranking", []))
         rows.append([name, f'{rec.get("backend")} / {rec.get("method")}', order])
-    body.append("<h2>Rankings</h2>" + table(["machine", "choice", "ranking (Mrays/s, cases conforming)"], rows))
+    rankings = table(["machine", "choice", "ranking (Mrays/s, cases conforming)"], rows)
     base = {c["name"]: c for c in all_results[0].get("matrix", {}).get("cases", []) if "time_ms" in c}
     base_devices = {b["backend"]: device_text(b) for b in all_results[0].get("ranking", [])}
     rows = []
@@ -1175,13 +950,10 @@ def machines(all_results, names):
             g = math.exp(sum(math.log(x) for x in v) / len(v))
             rows.append([name, b, base_devices.get(b, "?"), devices.get(b, "?"), len(v), f"{g:.3g}x",
                          f"{min(v):.3g}x", f"{max(v):.3g}x"])
-    if rows:
-        body.append(f"<h2>Speed-up over {esc(names[0])}</h2><p>Per backend, over the cases both measured: the "
-                    "geometric mean, least and greatest ratio of frame times (above 1: faster than the first "
-                    "machine), with the device each machine's backend ran on.</p>" +
-                    table(["machine", "backend", "device there", "device here", "cases", "geometric mean",
-                           "least", "greatest"], rows))
-    return PAGE.format(title="flatmarch: machines compared", body="\n".join(body))
+    speedups = table(["machine", "backend", "device there", "device here", "cases", "geometric mean", "least",
+                      "greatest"], rows) if rows else ""
+    return PAGE.page("flatmarch: machines compared", PAGE.machines(
+        html_(machine_table), html_(speed), html_(rankings), names[0], html_(speedups)))
 
 
 def read_results(path):
