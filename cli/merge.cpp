@@ -209,7 +209,8 @@ void add_merge(CLI::App& app) {
                   "Report shards: folders of the run's scenes, for the recommended gallery")
       ->capture_default_str();
   cmd->add_flag("--no-html", o->no_html, "Report shards: no gallery, no page");
-  cmd->add_option("--python", o->python, "python3 with matplotlib and jinja2 (env FLATMARCH_PYTHON)")
+  cmd->add_option("--python", o->python,
+                  "python3 with matplotlib and jinja2 (env FLATMARCH_PYTHON)")
       ->capture_default_str();
   cmd->callback([o] {
     Files docs;
