@@ -2,8 +2,7 @@
 # The test suite: installs what is missing, builds with warnings as errors and runs every test
 # (ctest); runs the unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer, in a
 # build without the GPU and browser backends; builds the scene parser fuzzers with clang and runs
-# each for a bounded time. Exits non-zero if any
-# stage fails; ends with the test runner's summary.
+# each for a bounded time. Exits non-zero if any stage fails; ends with the test runner's summary.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
