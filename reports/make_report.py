@@ -315,7 +315,7 @@ def ranking_section(results):
         rows.append(row)
     ranked = table(["rank", "backend", "device", "Mrays/s", "verdicts"] + [f"{m} Mrays/s" for m in methods] +
                    ["fastest conforming method"], rows)
-    return PAGE.ranking(results, rec, parameters, html_(ranked), "")
+    return PAGE.ranking(results, rec, parameters, html_(ranked))
 
 
 def device_time_section(results, cases):
