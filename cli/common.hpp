@@ -99,9 +99,10 @@ void write_json(const std::filesystem::path& file, const nlohmann::json& doc);
 
 // --- What `flatmarch report` and `flatmarch merge` share (cli/report.cpp).
 
-// The page of results files (reports/make_report.py with matplotlib, by `python`) in `out`:
-// one file's page, or several machines compared; `previous`: an earlier run's results, compared
-// case by case. runtime_error when it cannot be made.
+// The page of results files in `out`, one file's page or several machines compared; `previous`:
+// an earlier run's results, compared case by case. Its tables are worked out here
+// (reports/page.hpp) into `out`/page.json, its charts and HTML drawn by reports/make_report.py
+// (matplotlib, Jinja) run by `python`. runtime_error when it cannot be made.
 void make_report_page(const std::string& python, const std::vector<std::string>& results,
                       const std::filesystem::path& out, const std::string& previous);
 // python3 with matplotlib and jinja2: $FLATMARCH_PYTHON, else /usr/bin/python3.

@@ -16,6 +16,7 @@
 #include "conformance/suite.hpp"
 #include "output/dynamic_library.hpp"
 #include "reports/fingerprint.hpp"
+#include "reports/page.hpp"
 #include "reports/report.hpp"
 #include "reports/supervise.hpp"
 #include "scene/load.hpp"
@@ -39,8 +40,22 @@ std::string quoted(const std::string& word) {
 
 void make_report_page(const std::string& python, const std::vector<std::string>& results,
                       const fs::path& out, const std::string& previous) {
+  // The tables the page shows, worked out here (reports/page.hpp); the script draws the charts
+  // and fills the template with them.
+  json tables;
+  if (results.size() == 1) {
+    const json doc = read_json("RESULTS", results.front());
+    const json earlier = previous.empty() ? json() : read_json("--previous", previous);
+    tables = reports::page_tables(doc, previous.empty() ? nullptr : &earlier);
+  } else {
+    std::vector<std::pair<std::string, json>> runs;
+    for (const std::string& r : results) runs.emplace_back(r, read_json("RESULTS", r));
+    tables = reports::machines_tables(runs);
+  }
+  const fs::path tables_file = out / "page.json";
+  write_json(tables_file, tables);
   std::string command = quoted(python) + " " + quoted(data_file("reports/make_report.py")) +
-                        " -o " + quoted(out.string());
+                        " -o " + quoted(out.string()) + " --tables " + quoted(tables_file.string());
   if (!previous.empty()) command += " --previous " + quoted(previous);
   for (const std::string& r : results) command += " " + quoted(r);
   if (std::system(command.c_str()) != 0)

@@ -2,8 +2,8 @@
 // (agreement, doubt, a colour off, or the failure class of its ray) and the colour every image
 // of it takes, the checks a case is held to, the other causes a sweep names, the verdicts, and
 // the goals for the ambiguous share. The error images (suite.hpp), the report's difference maps
-// (reports/gallery.cpp) and the page (reports/make_report.py, through results.json's
-// "vocabulary") read them here; none restates them.
+// (reports/gallery.cpp) and the page (its tables, reports/page.cpp, and through them the
+// template and charts) read them here; none restates them.
 #pragma once
 
 #include <array>

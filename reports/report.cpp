@@ -87,7 +87,7 @@ std::vector<std::pair<std::string, double>> report_cases(const std::vector<Scene
 json report_header(const std::vector<Scene>& scenes, const ReportOptions& o) {
   json results = {{"format", "flatmarch-report/1"}, {"created", now_utc()}};
   results["fingerprint"] = hardware_fingerprint();
-  // The lists make_report.py draws by (it restates none).
+  // The lists the page draws by (it restates none).
   json methods = json::array();
   for (Method m : kKernelMethods) methods.push_back(to_string(m));
   json machine = json::array();  // the page's machine table, as the backends describe it

@@ -57,7 +57,7 @@ using ReportProgress =
 nlohmann::json run_report(const std::vector<Scene>& scenes, const ReportOptions& options,
                           const ReportProgress& progress);
 
-// The results' header: "format", "created", "fingerprint", "registry" (the lists make_report.py
+// The results' header: "format", "created", "fingerprint", "registry" (the lists the page
 // draws by), "vocabulary" (the suite's words, conformance/vocabulary.hpp) and "options".
 nlohmann::json report_header(const std::vector<Scene>& scenes, const ReportOptions& options);
 

@@ -182,10 +182,9 @@ def main():
     crashed.pop("regression", None)
     with open(os.path.join(out, "crashed.json"), "w") as f:
         json.dump(crashed, f)
-    drawn = subprocess.run([sys.executable, os.path.join(HERE, "..", "make_report.py"), "-o",
-                            os.path.join(out, "crashed"), os.path.join(out, "crashed.json")],
+    drawn = subprocess.run([flatmarch, "report", "-o", os.path.join(out, "crashed"), os.path.join(out, "crashed.json")],
                            capture_output=True, text=True, timeout=240)
-    expect(drawn.returncode == 0, f"make_report.py on a crashed case: {drawn.stderr[-1500:]}")
+    expect(drawn.returncode == 0, f"the page of a crashed case: {drawn.stderr[-1500:]}")
     if drawn.returncode == 0:
         dom = dump_dom(browser, os.path.join(out, "crashed", "index.html"), os.path.join(out, "profile"))
         expect('<div class="count crash"><b>1</b> crash</div>' in section(dom, "summary"),
