@@ -33,6 +33,7 @@ LAYERS = [
     "conformance",  # the suite against the oracle
     "plan",  # floor plans
     "reports",  # sweeps, matrix, the report and the gate
+    "history",  # every run kept, change points, the timeline
     "viewer",  # the first-person window
     "cli",  # the `flatmarch` program
 ]

@@ -35,6 +35,7 @@ int run(int argc, char** argv, std::vector<std::string> self) {
   add_report(app);
   add_select(app);
   add_sweep(app);
+  add_history(app);
   // CLI11 would only say that a subcommand is required.
   const auto subcommands = app.get_subcommands([](const CLI::App*) { return true; });
   const auto known = [&](const char* name) {

@@ -30,5 +30,6 @@ void add_merge(CLI::App& app);
 void add_report(CLI::App& app);
 void add_select(CLI::App& app);
 void add_sweep(CLI::App& app);
+void add_history(CLI::App& app);
 
 }  // namespace flatmarch::cli

@@ -14,7 +14,8 @@ fail() { echo "install_test: FAILED: $*" >&2; exit 1; }
 cmake --install "$build" --prefix "$work/prefix" > "$work/install.log" || fail "cmake --install"
 for f in bin/flatmarch lib/flatmarch/flatmarch_image.so share/flatmarch/scenes/torus.json \
   share/flatmarch/conformance/thresholds.json share/flatmarch/conformance/scenes \
-  share/flatmarch/reports/make_report.py share/flatmarch/reports/baseline.json; do
+  share/flatmarch/reports/make_report.py share/flatmarch/reports/baseline.json \
+  share/flatmarch/history/make_timeline.py share/flatmarch/history/timeline.html.j2; do
   [[ -e $work/prefix/$f ]] || fail "the install has no $f"
 done
 # No installed file may find its way back to the source or build tree.
