@@ -24,9 +24,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 PALETTE = ["#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"]
-# The figures of a report's case drawn per backend and scene: a timing and the cost every backend
-# of a method shares.
-CHARTED = [("rays_per_s", "Mrays/s", 1e-6), ("steps_mean", "mean steps per ray", 1.0)]
+# The figures of a report's case drawn per backend and scene: a timing, the cost every backend of
+# a method shares, and the CPU's count of the work where the machine counts it.
+CHARTED = [("rays_per_s", "Mrays/s", 1e-6), ("steps_mean", "mean steps per ray", 1.0),
+           ("instructions_per_ray", "instructions a ray (CPU's count)", 1.0)]
 
 
 def figure_html(fig, alt):

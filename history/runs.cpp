@@ -168,6 +168,11 @@ void read_report(const json& doc, Run& run) {
       }
       for (const char* f : {"steps_mean", "crossings_mean"})
         if (k.contains(f) && k[f].is_number()) run.measurements.push_back(fixed(name, f, k[f]));
+      // The CPU's count of the work (reports/work_count.hpp): nearly still from run to run, so a
+      // series of it shows a change a timing's wander hides.
+      if (k.contains("instructions_per_ray") && k["instructions_per_ray"].is_number())
+        run.measurements.push_back(timing(name, "instructions_per_ray", Judged::kLowerIsBetter,
+                                          k["instructions_per_ray"]));
     }
     if (c.contains("accuracy") && c["accuracy"].is_object()) {
       const json& a = c["accuracy"];

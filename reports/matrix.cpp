@@ -13,6 +13,7 @@
 
 #include "output/image_io.hpp"
 #include "reports/shard.hpp"
+#include "reports/work_count.hpp"
 #include "scene/surfaces.hpp"
 
 namespace flatmarch::reports {
@@ -143,13 +144,17 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
     std::optional<LaneFigures> figures;
   };
   auto lanes = std::make_shared<Lanes>();
+  // A CPU backend's instructions a ray (every thread, user space), counted over one frame of
+  // the colour once a case where the machine lets a process count them (work_count.hpp): 0
+  // where it does not, or for a backend on a device.
+  auto instructions_per_ray = std::make_shared<std::optional<double>>();
   benchmark::internal::Benchmark* b =
       benchmark::RegisterBenchmark(
           (name.empty() ? case_name(backend.name(), params.method, scene.name, width, height)
                         : name)
               .c_str(),
-          [&backend, &scene, camera, params, width, height, last, whole, lanes, peak_seconds,
-           label](benchmark::State& state) {
+          [&backend, &scene, camera, params, width, height, last, whole, lanes, peak_seconds, label,
+           instructions_per_ray, on_device = device.has_value()](benchmark::State& state) {
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
             DeviceTimes device_times;
             try {
@@ -159,6 +164,21 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                 *whole = backend.render(scene, camera, width, height, params, {});
                 backend.render_colour(scene, camera, width, height, params, {});
               }
+              if (!*instructions_per_ray) {
+                *instructions_per_ray = 0.0;
+                // After the frames above, whose threads (oneTBB's) it counts.
+                std::optional<WorkCounter> counter =
+                    on_device || !instructions_unavailable().empty()
+                        ? std::nullopt
+                        : WorkCounter::open(WorkCounter::Event::kInstructions, nullptr);
+                if (counter) {
+                  counter->start();
+                  backend.render_colour(scene, camera, width, height, params, {});
+                  *instructions_per_ray = static_cast<double>(counter->stop()) / (width * height);
+                }
+              }
+              if (**instructions_per_ray > 0.0)
+                state.counters["instructions_per_ray"] = **instructions_per_ray;
               for (auto _ : state) {
                 const auto start = std::chrono::steady_clock::now();
                 const Frame f = backend.render_colour(scene, camera, width, height, params, {});
@@ -405,6 +425,11 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
   const MatrixBackends& made = built ? *built : *own;
   const std::vector<std::unique_ptr<Backend>>& backends = made.available;
   json out = {{"cases", json::array()}, {"skipped", made.skipped}};
+  // Whether the CPU backends' cases count their instructions a ray, and why not.
+  if (o.timing)
+    out["work_counter"] = {{"event", "instructions"},
+                           {"available", instructions_unavailable().empty()},
+                           {"why", instructions_unavailable()}};
   for (const json& skip : out["skipped"])
     if (progress)
       progress(

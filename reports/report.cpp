@@ -775,7 +775,7 @@ json assemble_report(const json& header,
   json benchmarks = json::array(), context = json::object(), scaling_benchmarks = json::array();
   json points = json::array(), confirmations = json::array(), series = json::array();
   json sweep_options, seconds = json::object();
-  json matrix_skipped = json::array(), matrix_sampled, scaling_skipped;
+  json matrix_skipped = json::array(), matrix_sampled, matrix_work_counter, scaling_skipped;
   bool matrix_seen = false;
   std::string sweep_from;
   for (const auto& [label, doc] : parts) {
@@ -784,6 +784,8 @@ json assemble_report(const json& header,
         matrix_skipped = (*doc)["matrix"].value("skipped", json::array());
         matrix_sampled = (*doc)["matrix"].value("sampled", json());
       }
+      if (matrix_work_counter.is_null())
+        matrix_work_counter = (*doc)["matrix"].value("work_counter", json());
       matrix_seen = true;
       for (const json& c : (*doc)["matrix"].at("cases"))
         matrix[matrix_case_key(c["backend"], c["method"], c["scene"])] = c;
@@ -820,6 +822,7 @@ json assemble_report(const json& header,
                    {"skipped", matrix_skipped},
                    {"benchmarks", {{"context", context}, {"benchmarks", benchmarks}}}};
   if (!matrix_sampled.is_null()) out["matrix"]["sampled"] = matrix_sampled;
+  if (!matrix_work_counter.is_null()) out["matrix"]["work_counter"] = matrix_work_counter;
   for (const std::string& key : keys)
     if (matrix.count(key)) out["matrix"]["cases"].push_back(matrix[key]);
   if (!sweep_options.is_null())

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -75,6 +76,21 @@ TEST(HistoryDatabase, AddingTheSameRunTwiceKeepsOne) {
   EXPECT_EQ(points[0].repetitions, 3);
   // The samples' sample standard deviation over their median: 0.01 of it, by hand.
   EXPECT_NEAR(points[0].spread, 0.01, 1e-9);
+}
+
+TEST(HistoryDatabase, KeepsTheCpusCountOfTheWorkAsASeries) {
+  // Where the machine counts instructions (reports/work_count.hpp) a case carries them a ray.
+  json r = report(1e6, 10.0);
+  r["matrix"]["cases"][0]["counters"]["instructions_per_ray"] = 5123.0;
+  const fs::path results = scratch("work.json");
+  write(results, r.dump());
+  const history::Run run = read_run(results, "c1");
+  const auto at =
+      std::find_if(run.measurements.begin(), run.measurements.end(),
+                   [](const Measurement& m) { return m.figure == "instructions_per_ray"; });
+  ASSERT_NE(at, run.measurements.end());
+  EXPECT_EQ(at->judged, Judged::kLowerIsBetter);
+  EXPECT_DOUBLE_EQ(at->value, 5123.0);
 }
 
 TEST(HistoryDatabase, RefusesFilesItCannotKeepSayingWhy) {

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <thread>
 
 #include "conformance/suite.hpp"
 #include "conformance/vocabulary.hpp"
@@ -14,6 +17,7 @@
 #include "reports/gallery.hpp"
 #include "reports/matrix.hpp"
 #include "reports/report.hpp"
+#include "reports/work_count.hpp"
 #include "scene/load.hpp"
 #include "scene/surfaces.hpp"
 #include "tests/process.hpp"
@@ -578,6 +582,50 @@ TEST(Gallery, TheDifferenceMapCountsEveryPixelAndShowsFailures) {
 }
 
 // The commands end to end, on the torus and the scalar backend at a small size.
+TEST(WorkCounter, SumsEveryThreadOfTheProcess) {
+  // Two threads made before the counter opens each burn 30 ms of their own CPU time; the task
+  // clock (a software event every kernel has: the same code path as instructions) counts both.
+  std::atomic<bool> go = false;
+  const auto burn = [&go] {
+    while (!go.load()) std::this_thread::yield();
+    timespec t0{}, t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+    volatile uint64_t x = 0;
+    do {
+      for (int k = 0; k < 10000; ++k) x = x + static_cast<uint64_t>(k);
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    } while ((t.tv_sec - t0.tv_sec) * 1000000000L + (t.tv_nsec - t0.tv_nsec) < 30000000L);
+  };
+  std::thread a(burn), b(burn);
+  std::string why;
+  std::optional<WorkCounter> counter = WorkCounter::open(WorkCounter::Event::kTaskClock, &why);
+  if (!counter) {
+    go = true;
+    a.join();
+    b.join();
+    GTEST_SKIP() << "no task clock to count: " << why;
+  }
+  counter->start();
+  go = true;
+  a.join();
+  b.join();
+  EXPECT_GE(counter->stop(), 60000000u);  // ns: both threads' 30 ms
+}
+
+TEST(WorkCounter, CountsInstructionsOrSaysWhyNot) {
+  std::string why;
+  std::optional<WorkCounter> counter = WorkCounter::open(WorkCounter::Event::kInstructions, &why);
+  EXPECT_EQ(counter.has_value(), instructions_unavailable().empty());
+  if (!counter) {
+    EXPECT_NE(why.find("perf_event_open"), std::string::npos) << why;
+    return;
+  }
+  counter->start();
+  volatile uint64_t x = 0;
+  for (int k = 0; k < 1000000; ++k) x = x + static_cast<uint64_t>(k);
+  EXPECT_GE(counter->stop(), 1000000u);  // at least an instruction an iteration
+}
+
 TEST(ReportCommand, MeasuresSelectsAndGates) {
   const std::string dir = test::make_temp_dir();
   const std::string torus = std::string(FLATMARCH_SOURCE_DIR) + "/scenes/torus.json";
@@ -615,6 +663,13 @@ TEST(ReportCommand, MeasuresSelectsAndGates) {
   EXPECT_EQ(c["time_samples_ms"].size(), 3u);
   EXPECT_TRUE(c["accuracy"]["passed"].get<bool>());
   EXPECT_GT(c["counters"]["steps_mean"].get<double>(), 1.0);
+  // The work a ray does in instructions where this machine counts them, else why not.
+  const json& work = results["matrix"]["work_counter"];
+  EXPECT_EQ(work["available"].get<bool>(), instructions_unavailable().empty()) << work;
+  if (work["available"].get<bool>())
+    EXPECT_GT(c["counters"].value("instructions_per_ray", 0.0), 100.0) << c["counters"];
+  else
+    EXPECT_FALSE(c["counters"].contains("instructions_per_ray")) << work;
   EXPECT_EQ(results["recommendation"]["backend"], "scalar");
   // No --baseline: the committed one was measured at another size, so nothing is checked, and
   // the page will say why.
