@@ -94,6 +94,12 @@ std::vector<std::string> worker_command() {
   return command;
 }
 
+std::string shell_quoted(const std::string& word) {
+  std::string q = "'";
+  for (const char ch : word) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return q + "'";
+}
+
 std::string quoted_command_line(const std::string& extra) {
   std::vector<std::string> args = g_args;
   if (!extra.empty() && std::find(args.begin(), args.end(), extra) == args.end())
@@ -103,9 +109,7 @@ std::string quoted_command_line(const std::string& extra) {
     const bool plain = !a.empty() && std::all_of(a.begin(), a.end(), [](char ch) {
       return std::isalnum(static_cast<unsigned char>(ch)) || std::strchr("-_./=:,+@%", ch);
     });
-    std::string quoted = "'";
-    for (const char ch : a) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-    line += (line.empty() ? "" : " ") + (plain ? a : quoted + "'");
+    line += (line.empty() ? "" : " ") + (plain ? a : shell_quoted(a));
   }
   return line;
 }

@@ -105,6 +105,8 @@ void write_json(const std::filesystem::path& file, const nlohmann::json& doc);
 // (matplotlib, Jinja) run by `python`. runtime_error when it cannot be made.
 void make_report_page(const std::string& python, const std::vector<std::string>& results,
                       const std::filesystem::path& out, const std::string& previous);
+// A word for the shell (sh -c, std::system), quoted.
+std::string shell_quoted(const std::string& word);
 // python3 with matplotlib and jinja2: $FLATMARCH_PYTHON, else /usr/bin/python3.
 std::string default_python();
 // The results' regression section: checked against `baseline` (a file; "" for the committed

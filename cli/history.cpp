@@ -18,13 +18,6 @@ using nlohmann::json;
 
 namespace {
 
-// A word for the shell, quoted.
-std::string shell_word(const std::string& word) {
-  std::string q = "'";
-  for (char c : word) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 // The commit a run is of: --commit, else $GITHUB_SHA (a CI job's), else the checkout's HEAD.
 std::string commit_of(const std::string& given) {
   if (!given.empty()) return given;
@@ -55,11 +48,15 @@ history::Database open_database(const std::string& path, bool must_exist) {
   }
 }
 
-history::ChangeOptions change_options(double threshold, double min_change) {
-  history::ChangeOptions o;
-  o.threshold = threshold;
-  o.min_change = min_change;
-  return o;
+// The change points' two limits, options of each command that judges the series.
+void add_change_options(CLI::App& cmd, history::ChangeOptions& o) {
+  cmd.add_option("--threshold", o.threshold,
+                 "Change points' z (t-corrected where the variances are estimated from few runs)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 20.0));
+  cmd.add_option("--min-change", o.min_change, "Smallest relative timing change reported")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
 }
 
 // One finding in a line: where, what changed, between which commits.
@@ -140,7 +137,7 @@ void add_history_query(CLI::App& history, const std::shared_ptr<std::string>& db
   struct Options {
     std::string case_name, figure, machine;
     bool json = false;
-    double threshold = 4.0, min_change = 0.02;
+    history::ChangeOptions changes;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("CASE", o->case_name,
@@ -148,12 +145,10 @@ void add_history_query(CLI::App& history, const std::shared_ptr<std::string>& db
   cmd->add_option("--figure", o->figure, "One figure (default: every figure of the case)");
   cmd->add_option("--machine", o->machine, "One machine's key (default: every machine)");
   cmd->add_flag("--json", o->json, "JSON: the series with their change points");
-  cmd->add_option("--threshold", o->threshold, "Change points' z")->capture_default_str();
-  cmd->add_option("--min-change", o->min_change, "Smallest relative timing change reported")
-      ->capture_default_str();
+  add_change_options(*cmd, o->changes);
   cmd->callback([o, db] {
     const history::Database d = open_database(*db, true);
-    const json analysed = history::analyse(d, change_options(o->threshold, o->min_change));
+    const json analysed = history::analyse(d, o->changes);
     if (o->case_name.empty()) {
       if (o->json) {
         std::printf("%s\n", analysed["runs"].dump(1).c_str());
@@ -208,14 +203,11 @@ void add_history_check(CLI::App& history, const std::shared_ptr<std::string>& db
       "What the newest run of each series changed: exit 1 on a deterministic change (steps,\n"
       "crossings, accuracy, verdict) that no baseline commit accepted (the gate's baseline did\n"
       "not change with it); timing regressions still open are printed as warnings.");
-  auto threshold = std::make_shared<double>(4.0), min_change = std::make_shared<double>(0.02);
-  cmd->add_option("--threshold", *threshold, "Change points' z")->capture_default_str();
-  cmd->add_option("--min-change", *min_change, "Smallest relative timing change reported")
-      ->capture_default_str();
-  cmd->callback([db, threshold, min_change] {
+  auto limits = std::make_shared<history::ChangeOptions>();
+  add_change_options(*cmd, *limits);
+  cmd->callback([db, limits] {
     const history::Database d = open_database(*db, true);
-    const json changes =
-        history::newest_changes(history::analyse(d, change_options(*threshold, *min_change)));
+    const json changes = history::newest_changes(history::analyse(d, *limits));
     for (const json& f : changes["timing"])
       std::printf("warning: slower: %s\n", describe(f).c_str());
     for (const json& f : changes["accepted"]) std::printf("accepted: %s\n", describe(f).c_str());
@@ -240,26 +232,25 @@ void add_history_report(CLI::App& history, const std::shared_ptr<std::string>& d
       "timeline.json holds what it shows.");
   struct Options {
     std::string out = "history", python = default_python();
-    double threshold = 4.0, min_change = 0.02;
+    history::ChangeOptions changes;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("-o,--out", o->out, "Output folder")->capture_default_str();
   cmd->add_option("--python", o->python,
                   "python3 with matplotlib and jinja2 (env FLATMARCH_PYTHON)")
       ->capture_default_str();
-  cmd->add_option("--threshold", o->threshold, "Change points' z")->capture_default_str();
-  cmd->add_option("--min-change", o->min_change, "Smallest relative timing change reported")
-      ->capture_default_str();
+  add_change_options(*cmd, o->changes);
   cmd->callback([o, db] {
     const history::Database d = open_database(*db, true);
-    json analysed = history::analyse(d, change_options(o->threshold, o->min_change));
+    json analysed = history::analyse(d, o->changes);
     analysed["database"] = fs::absolute(*db).string();
-    analysed["options"] = {{"threshold", o->threshold}, {"min_change", o->min_change}};
+    analysed["options"] = {{"threshold", o->changes.threshold},
+                           {"min_change", o->changes.min_change}};
     const fs::path data = fs::path(o->out) / "timeline.json";
     write_json(data, analysed);
-    const std::string command = shell_word(o->python) + " " +
-                                shell_word(data_file("history/make_timeline.py")) + " -o " +
-                                shell_word(o->out) + " " + shell_word(data.string());
+    const std::string command = shell_quoted(o->python) + " " +
+                                shell_quoted(data_file("history/make_timeline.py")) + " -o " +
+                                shell_quoted(o->out) + " " + shell_quoted(data.string());
     if (std::system(command.c_str()) != 0)
       throw std::runtime_error("the timeline page could not be made (" + command +
                                " failed; it needs python3 with matplotlib and jinja2: "

@@ -27,17 +27,6 @@ namespace flatmarch::cli {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-namespace {
-
-// A word for the shell, quoted.
-std::string quoted(const std::string& word) {
-  std::string q = "'";
-  for (char c : word) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-}  // namespace
-
 void make_report_page(const std::string& python, const std::vector<std::string>& results,
                       const fs::path& out, const std::string& previous) {
   // The tables the page shows, worked out here (reports/page.hpp); the script draws the charts
@@ -54,10 +43,11 @@ void make_report_page(const std::string& python, const std::vector<std::string>&
   }
   const fs::path tables_file = out / "page.json";
   write_json(tables_file, tables);
-  std::string command = quoted(python) + " " + quoted(data_file("reports/make_report.py")) +
-                        " -o " + quoted(out.string()) + " --tables " + quoted(tables_file.string());
-  if (!previous.empty()) command += " --previous " + quoted(previous);
-  for (const std::string& r : results) command += " " + quoted(r);
+  std::string command =
+      shell_quoted(python) + " " + shell_quoted(data_file("reports/make_report.py")) + " -o " +
+      shell_quoted(out.string()) + " --tables " + shell_quoted(tables_file.string());
+  if (!previous.empty()) command += " --previous " + shell_quoted(previous);
+  for (const std::string& r : results) command += " " + shell_quoted(r);
   if (std::system(command.c_str()) != 0)
     throw std::runtime_error("the charts and the page could not be made (" + command +
                              " failed; it needs python3 with matplotlib and jinja2: "

@@ -440,7 +440,7 @@ json previous_table(const json& results, const json& previous,
     }
     const double ra = a.contains("counters") ? a["counters"].value("rays_per_s", 0.0) : 0.0;
     const double rb = b.contains("counters") ? b["counters"].value("rays_per_s", 0.0) : 0.0;
-    if (ra && rb) m.speed = rb / ra;
+    if (ra != 0.0 && rb != 0.0) m.speed = rb / ra;
     if ((m.hit && std::abs(*m.hit) > 1e-4) || (m.ambiguous && std::abs(*m.ambiguous) > 1e-4) ||
         (m.speed && !(0.9 <= *m.speed && *m.speed <= 1.1)))
       moved.push_back(m);
