@@ -64,6 +64,23 @@ def fill(text, matrix, total):
     return re.sub(r"\$\{\{(.*?)\}\}", value, text)
 
 
+def job_runs(job):
+    """Whether a job's `if` holds for the event the test simulates (workflow_dispatch: no
+    schedule): terms joined by &&, each !cancelled() or github.event.schedule == or != 'CRON'."""
+    condition = str(job.get("if", "true")).strip()
+    condition = re.sub(r"^\$\{\{(.*)\}\}$", r"\1", condition).strip()
+    result = True
+    for term in (t.strip() for t in condition.split("&&")):
+        m = re.fullmatch(r"github\.event\.schedule\s*(==|!=)\s*'([^']*)'", term)
+        if term in ("true", "!cancelled()", "always()"):
+            continue
+        if not m:
+            raise ValueError("a job condition the test does not know: " + term)
+        same = GITHUB_CONTEXT.get("event.schedule", "") == m.group(2)
+        result = result and (same if m.group(1) == "==" else not same)
+    return result
+
+
 def checkout(workspace, ctx):
     """actions/checkout: this source tree, with the build folder under test as its build/."""
     for entry in os.listdir(ctx["source"]):
@@ -173,6 +190,9 @@ def main():
     jobs = workflow["jobs"]
     for name in job_order(jobs):
         job = jobs[name]
+        if not job_runs(job):
+            print(f"{name}: skipped ({job['if']})")
+            continue
         runs = list(entries(job))
         for k, matrix in enumerate(runs):
             workspace = os.path.join(out, f"{name}-{k + 1}")
