@@ -47,13 +47,6 @@ ALTER TABLE runs ADD COLUMN baseline TEXT NOT NULL DEFAULT '';
 CREATE INDEX measurements_by_case ON measurements(case_name, figure);
 )";
 
-std::string now_utc() {
-  const std::time_t t = std::time(nullptr);
-  char s[32];
-  std::strftime(s, sizeof s, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-  return s;
-}
-
 // A prepared statement, finalised when it goes.
 class Statement {
  public:
@@ -197,7 +190,10 @@ std::optional<int64_t> Database::add(const Run& run) {
                 "INSERT INTO runs(digest, kind, commit_id, created, added, machine, machine_text, "
                 "build, options, source, page, baseline) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
     r.bind(1, run.digest).bind(2, run.kind).bind(3, run.commit).bind(4, run.created);
-    r.bind(5, now_utc()).bind(6, run.machine).bind(7, run.machine_text).bind(8, run.build);
+    r.bind(5, utc_text(std::time(nullptr)))
+        .bind(6, run.machine)
+        .bind(7, run.machine_text)
+        .bind(8, run.build);
     r.bind(9, run.options).bind(10, run.source).bind(11, run.page).bind(12, run.baseline);
     r.step();
     const int64_t id = sqlite3_last_insert_rowid(db_);

@@ -34,6 +34,12 @@ Judged judged_from_string(const std::string& text) {
   throw std::invalid_argument("not a way of judging a figure: " + text);
 }
 
+std::string utc_text(std::time_t t) {
+  char s[32];
+  std::strftime(s, sizeof s, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return s;
+}
+
 std::string digest_of(const std::string& text) {
   // FNV-1a, 64 bits, from two offset bases: 128 bits of digest, stable everywhere.
   uint64_t a = 14695981039346656037ull, b = 1099511628211ull * 31ull;
@@ -313,10 +319,7 @@ Run read_run(const fs::path& file, const std::string& commit, const fs::path& ba
   }
   if (run.created.empty()) {  // a file that does not say when: when it was written
     const auto written = std::chrono::file_clock::to_sys(fs::last_write_time(file));
-    const std::time_t t = std::chrono::system_clock::to_time_t(written);
-    char when[32];
-    std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-    run.created = when;
+    run.created = utc_text(std::chrono::system_clock::to_time_t(written));
   }
   return run;
 }

@@ -4,6 +4,7 @@
 // as a series).
 #pragma once
 
+#include <ctime>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -53,6 +54,9 @@ struct Run {
 // JSON, another program's JSON, a results file without cases.
 Run read_run(const std::filesystem::path& file, const std::string& commit,
              const std::filesystem::path& baseline = {});
+
+// A time as the results files write it: ISO 8601 in UTC ("2026-12-05T10:00:00Z").
+std::string utc_text(std::time_t t);
 
 // A stable digest of text (two 64-bit FNV-1a hashes, 32 hex digits): the same on every machine.
 std::string digest_of(const std::string& text);
