@@ -48,3 +48,27 @@ const char* const kKernelShapeHelp =
     "loops testing first); auto: software on llvmpipe and lavapipe, gpu on a GPU";
 
 }  // namespace flatmarch
+
+namespace flatmarch {
+
+MarchParams ExternalInfo::marches_with(MarchParams asked) const {
+  for (const auto& [name, value] : fixed) {
+    if (name == "eps") asked.eps = value;
+    if (name == "offset") asked.offset = value;
+    if (name == "max_steps") asked.max_steps = static_cast<int>(value);
+    if (name == "max_distance") asked.max_distance = value;
+    if (name == "omega") asked.omega = value;
+  }
+  return asked;
+}
+
+std::string ExternalInfo::cannot_read(const Scene& scene) const {
+  const auto reads = [&](const char* format) {
+    return std::find(scene_formats.begin(), scene_formats.end(), format) != scene_formats.end();
+  };
+  if (reads("flatmarch") || (reads("peer-app") && !scene.imported_from.empty())) return {};
+  return "it reads only the web app's geometry files, and scene " + scene.name +
+         " was not converted from one";
+}
+
+}  // namespace flatmarch

@@ -7,6 +7,7 @@
 #include <memory>
 #include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <variant>
@@ -83,6 +84,35 @@ struct LaneFigures {
   double one_thread_rays_per_s = 0.0;
 };
 
+// What a renderer we did not write, called as a command (conformance/external.hpp,
+// docs/external.md), gives and how it is judged: the channels it writes, its look, the march
+// parameters it has built in.
+struct ExternalInfo {
+  std::string manifest;  // its manifest file
+  std::string version, description;
+  bool colour = true, hit = true, crossings = true, steps = true, t = true;
+  // The look its colour is judged in: "flatmarch" (DESIGN.md's), "peer-app" (the web app's) or
+  // "none" (not judged).
+  std::string look = "flatmarch";
+  // The march parameters it has built in, whatever it is asked (eps, offset, max_steps,
+  // max_distance, omega).
+  std::vector<std::pair<std::string, double>> fixed;
+  // The scene files it reads: "flatmarch" (ours), "peer-app" (the web app's geometries).
+  std::vector<std::string> scene_formats = {"flatmarch"};
+  std::string expectations;  // its expectation file (conformance/expectations.hpp), if any
+  // The parameters it marches with when asked for `asked`: `fixed` over them.
+  MarchParams marches_with(MarchParams asked) const;
+  // Why it cannot be given `scene` (it reads only the app's format, and the scene was not
+  // converted from it), or empty.
+  std::string cannot_read(const Scene& scene) const;
+};
+
+// A case a renderer cannot render (a scene it cannot express, a format it cannot read): skipped,
+// saying why, neither a failure nor an error.
+struct CaseSkipped : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // Called now and then during long work with the fraction done, in [0, 1].
 using Progress = std::function<void(double)>;
 
@@ -128,6 +158,8 @@ class Backend {
   // SwiftShader's threads after the case, slowing the next cases of the other backends). The
   // next frame opens what it needs again.
   virtual void rest() const {}
+  // What it is where it is a renderer we did not write, called as a command; null for ours.
+  virtual const ExternalInfo* external() const { return nullptr; }
   // Its lanes' figures for a case (LaneFigures; the peak timed for about `peak_seconds`); none
   // from a backend without lanes.
   virtual std::optional<LaneFigures> lane_figures(const Scene& scene, const Camera& camera,
@@ -231,8 +263,8 @@ std::vector<BackendEntry> built_in_backends();
 // The registered backends: the built-in ones, then any a program added.
 const std::vector<BackendEntry>& backend_registry();
 // Adds a backend after the built-in ones (a test's own backend, registered by a static
-// initialiser). Throws std::logic_error on a name already taken, or once backends() has been
-// called.
+// initialiser; an external renderer, from the command line). Throws std::logic_error on a name
+// already taken.
 bool register_backend(BackendEntry entry);
 // The names of the registered backends, and of those that run the kernel.
 std::vector<std::string> backend_names();

@@ -16,8 +16,6 @@ std::vector<BackendEntry>& registry() {
   return entries;
 }
 
-bool backends_made = false;  // backends() has made its list: the registry is closed
-
 }  // namespace
 
 const std::vector<BackendEntry>& backend_registry() {
@@ -25,8 +23,6 @@ const std::vector<BackendEntry>& backend_registry() {
 }
 
 bool register_backend(BackendEntry entry) {
-  if (backends_made)
-    throw std::logic_error("register_backend(" + entry.name + "): after backends() was called");
   for (const BackendEntry& e : registry())
     if (e.name == entry.name)
       throw std::logic_error("register_backend: a backend named " + entry.name + " exists");
@@ -60,12 +56,10 @@ std::unique_ptr<Backend> make_backend(const std::string& name, const BackendOpti
 }
 
 const std::vector<std::unique_ptr<Backend>>& backends() {
-  static const std::vector<std::unique_ptr<Backend>> all = [] {
-    backends_made = true;
-    std::vector<std::unique_ptr<Backend>> v;
-    for (const BackendEntry& e : registry()) v.push_back(e.make({}));
-    return v;
-  }();
+  // Made as entries come: a backend registered late (an external renderer, from the command
+  // line once the commands' options are made) joins the list on the next call.
+  static std::vector<std::unique_ptr<Backend>> all;
+  while (all.size() < registry().size()) all.push_back(registry()[all.size()].make({}));
   return all;
 }
 

@@ -20,6 +20,8 @@
 #include <variant>
 
 #include "backends/oracle/oracle.hpp"
+#include "conformance/external.hpp"
+#include "interop/peer_import.hpp"
 #include "kernels/compile.hpp"
 #include "output/image_library.hpp"
 #include "scene/load.hpp"
@@ -252,6 +254,31 @@ std::unique_ptr<Backend> make_kernel_backend(const std::string& name,
   return backend;
 }
 
+void add_external_option(CLI::App& app, std::vector<std::string>& specs) {
+  app.add_option("--external", specs,
+                 "NAME=MANIFEST: a renderer we did not write, called as a command and judged "
+                 "beside the backends (repeat; docs/external.md has the protocol; its cases are "
+                 "BACKEND/METHOD/SCENE with NAME as the backend, its time its command's)");
+}
+
+std::vector<std::string> register_externals(const std::vector<std::string>& specs) {
+  std::vector<std::string> names;
+  for (const std::string& spec : specs) {
+    BackendEntry entry;
+    try {
+      entry = conformance::external_entry(spec);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--external: ") + e.what());
+    }
+    if (find_backend_entry(entry.name))
+      throw UsageError("--external " + spec + ": a backend named " + entry.name +
+                       " exists; name it otherwise (NAME=MANIFEST)");
+    names.push_back(entry.name);
+    register_backend(std::move(entry));
+  }
+  return names;
+}
+
 void check_march_params(const MarchParams& params) {
   if (!(params.eps > 0.0) || !std::isfinite(params.eps))
     throw UsageError("--eps: must be a positive number");
@@ -371,7 +398,7 @@ std::string named_scene_file(const std::string& file_or_name) {
 }
 
 Scene load_named_scene(const std::string& file_or_name) {
-  return load_scene(named_scene_file(file_or_name));
+  return load_scene_or_app_geometry(named_scene_file(file_or_name));
 }
 
 namespace {
@@ -390,6 +417,18 @@ std::filesystem::path scene_file(const std::string& name,
 }
 
 }  // namespace
+
+Scene load_scene_or_app_geometry(const std::filesystem::path& file) {
+  const nlohmann::json doc = read_json_file(file);
+  if (!is_peer_geometry(doc)) {
+    Scene scene = scene_from_json(doc, file.string());
+    scene.source_file = file.string();
+    return scene;
+  }
+  PeerImport imported = import_peer_file(file);
+  imported.scene["name"] = "app_" + file.stem().string();
+  return scene_from_json(imported.scene, file.string());
+}
 
 std::vector<Scene> load_scenes(const std::vector<std::string>& names,
                                const std::vector<std::string>& galleries) {
@@ -411,7 +450,7 @@ std::vector<Scene> load_scenes(const std::vector<std::string>& names,
                        " (run from the source folder, or give --scene or --gallery)");
   }
   std::vector<Scene> scenes;
-  for (const fs::path& f : files) scenes.push_back(load_scene(f));
+  for (const fs::path& f : files) scenes.push_back(load_scene_or_app_geometry(f));
   return scenes;
 }
 

@@ -80,6 +80,9 @@ extern const char* const kSceneArgumentHelp;
 // The scenes named by --scene (a file, or a scene's name in one of the --gallery folders) or,
 // when none is named, every scene of the folders, each folder's sorted by file name. UsageError
 // when a name is found nowhere or the folders hold no scene.
+// A scene file of ours, or a geometry of the web app's, converted as import-peer converts it and
+// named app_STEM (imported_from says which file).
+Scene load_scene_or_app_geometry(const std::filesystem::path& file);
 std::vector<Scene> load_scenes(const std::vector<std::string>& names,
                                const std::vector<std::string>& galleries);
 
@@ -126,6 +129,12 @@ Precision parse_precision(const std::string& text);
 // backend that does not run the kernel (the oracle, which the others are measured against).
 std::unique_ptr<Backend> make_kernel_backend(const std::string& name,
                                              const BackendOptions& options);
+
+// --external NAME=MANIFEST (repeat): renderers we did not write, judged beside the backends
+// (docs/external.md). register_externals adds each to the backend registry (before anything
+// lists the backends) and returns their names; UsageError for a manifest it cannot use.
+void add_external_option(CLI::App& app, std::vector<std::string>& specs);
+std::vector<std::string> register_externals(const std::vector<std::string>& specs);
 
 // The march parameters' options (--eps, --offset, --max-steps, --max-distance, --omega), each
 // declared here once with one help text; check_march_params holds each to one range. A command

@@ -11,6 +11,7 @@
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "cli/supervised.hpp"
+#include "conformance/expectations.hpp"
 #include "conformance/suite.hpp"
 #include "conformance/vocabulary.hpp"
 #include "output/image_io.hpp"
@@ -47,14 +48,26 @@ std::string failures_summary(const conformance::CaseResult& r) {
 std::string table_lines(const conformance::CaseResult& r) {
   int diverged = 0;
   for (const auto& t : r.traces) diverged += t.failure.has_value();
+  // What a renderer we did not write does not give: "-".
+  const auto shown = [&](const char* check, const std::string& value) {
+    return std::find(r.unmeasured.begin(), r.unmeasured.end(), check) == r.unmeasured.end()
+               ? value
+               : std::string("-");
+  };
+  char ks[32], traces[32];
+  std::snprintf(ks, sizeof ks, "%.3f", r.steps_ks);
+  std::snprintf(traces, sizeof traces, "%d/%zu", diverged, r.traces.size());
   char row[512];
   std::snprintf(
-      row, sizeof row, "%-8s %-30s %-9s %7s %8s %8s %7s %7.3f %3d/%-2zu  %-24s %s\n",
-      r.backend.c_str(), r.scene.c_str(), to_string(r.params.method),
+      row, sizeof row, "%-8s %-30s %-9s %7s %8s %8s %7s %7s %6s  %-24s %s\n", r.backend.c_str(),
+      r.scene.c_str(), to_string(r.params.method),
       percent(static_cast<double>(r.aov.ambiguous) / static_cast<double>(r.aov.pixels)).c_str(),
-      percent(r.aov.hit_rate()).c_str(), percent(r.aov.crossings_rate()).c_str(),
-      percent(static_cast<double>(r.image.fail) / static_cast<double>(r.image.pixels)).c_str(),
-      r.steps_ks, diverged, r.traces.size(), failures_summary(r).c_str(),
+      shown("hit_rate", percent(r.aov.hit_rate())).c_str(),
+      shown("crossings_rate", percent(r.aov.crossings_rate())).c_str(),
+      shown("image",
+            percent(static_cast<double>(r.image.fail) / static_cast<double>(r.image.pixels)))
+          .c_str(),
+      shown("steps", ks).c_str(), shown("traces", traces).c_str(), failures_summary(r).c_str(),
       r.verdict == conformance::Verdict::pass    ? "pass"
       : r.verdict == conformance::Verdict::limit ? "limit"
                                                  : "FAIL");
@@ -92,6 +105,7 @@ void add_conform(CLI::App& app) {
     MarchParams params;
     BackendOptions backend_options;
     std::string shard;
+    std::vector<std::string> externals;
     bool quiet = false;
     bool strict = false;
     SupervisionOptions supervision;
@@ -119,6 +133,7 @@ void add_conform(CLI::App& app) {
   cmd->add_option("--precision", o->precision, "f32 or f64 (backends without f64 are skipped)")
       ->capture_default_str();
   add_backend_options(*cmd, o->backend_options);
+  add_external_option(*cmd, o->externals);
   cmd->add_option("--shard", o->shard,
                   "I/N: run only shard I of N of the cases (split by their expected cost, the same "
                   "in every shard), for a scheduler to run the shards apart; `flatmarch merge` "
@@ -128,6 +143,7 @@ void add_conform(CLI::App& app) {
   cmd->add_flag("--strict", o->strict,
                 "Exit 1 when a case is at its method's limit too, not only when one fails");
   cmd->callback([o] {
+    const std::vector<std::string> externals = register_externals(o->externals);
     const std::pair<int, int> size = parse_size("--size", o->size);
     const int w = size.first, h = size.second;
     check_frame_memory("--size", w, h, kCaseFrames, "a conformance case");
@@ -144,6 +160,9 @@ void add_conform(CLI::App& app) {
         warn_about_resolution(scene, sphere);
       }
     if (o->backends.empty()) o->backends = kernel_backend_names();
+    for (const std::string& name : externals)
+      if (std::find(o->backends.begin(), o->backends.end(), name) == o->backends.end())
+        o->backends.push_back(name);
     nlohmann::json thresholds = conformance::builtin_thresholds();
     if (!o->thresholds.empty()) {
       try {
@@ -197,13 +216,45 @@ void add_conform(CLI::App& app) {
       }
       backends.push_back(std::move(backend));
     }
+    // A renderer we did not write runs the cases it can: its methods, the scenes it reads, and
+    // not those its expectation file skips; the others are skipped, saying why.
+    std::map<std::string, conformance::Expectations> expectations;
+    for (const auto& backend : backends)
+      if (const ExternalInfo* info = backend->external(); info && !info->expectations.empty()) {
+        try {
+          expectations[backend->name()] = conformance::Expectations::read(info->expectations);
+        } catch (const std::invalid_argument& e) {
+          throw UsageError(std::string("--external ") + backend->name() + ": " + e.what());
+        }
+      }
+    const auto skip_why = [&](const Backend& backend, const Scene& scene, Method m) {
+      const ExternalInfo* info = backend.external();
+      if (!info) return std::string();
+      const std::vector<Method> own = backend.methods();
+      if (std::find(own.begin(), own.end(), m) == own.end())
+        return "it renders no " + std::string(to_string(m)) + " cases (its manifest's methods)";
+      if (std::string why = info->cannot_read(scene); !why.empty()) return why;
+      const auto e = expectations.find(backend.name());
+      if (e != expectations.end() &&
+          e->second.skipped(backend.name() + "/" + to_string(m) + "/" + scene.name))
+        return "its expectation file skips it (" + e->second.file() + ")";
+      return std::string();
+    };
     std::vector<std::pair<std::string, double>> run;
     for (const auto& backend : backends)
       for (const Scene& scene : scenes)
-        for (const Method m : methods)
-          run.emplace_back(backend->name() + "/" + to_string(m) + "/" + scene.name,
-                           reports::conformance_case_cost(backend->name(), to_string(m),
-                                                          reports::edge_count(scene), w, h));
+        for (const Method m : methods) {
+          const std::string key = backend->name() + "/" + to_string(m) + "/" + scene.name;
+          if (const std::string why = skip_why(*backend, scene, m); !why.empty()) {
+            out["skipped"].push_back({{"backend", backend->name()},
+                                      {"scene", scene.name},
+                                      {"method", to_string(m)},
+                                      {"reason", why}});
+            continue;
+          }
+          run.emplace_back(key, reports::conformance_case_cost(backend->name(), to_string(m),
+                                                               reports::edge_count(scene), w, h));
+        }
     const reports::ShardPlan plan = reports::plan_shard(shard.value_or(reports::Shard{}), run);
     if (shard) {
       out["shard"] = plan.record;
@@ -223,6 +274,7 @@ void add_conform(CLI::App& app) {
       for (const auto& backend : backends)
         for (const Scene& scene : scenes)
           for (const Method m : methods) {
+            if (!skip_why(*backend, scene, m).empty()) continue;
             const auto& [key, cost] = run[k++];
             if (plan.holds(key)) held.push_back({key, backend.get(), &scene, m, cost});
           }
@@ -274,13 +326,19 @@ void add_conform(CLI::App& app) {
       supervised.cases.push_back({c.key, c.cost});
       by_key[c.key] = &c;
     }
-    int unfinished = 0;
+    int unfinished = 0, skipped = 0;
     const auto show = [&](const std::string& key, const nlohmann::json& record) {
       if (shard && !o->quiet)
         std::fprintf(stderr, "conform: shard %s: case %d of %zu\n", shard->text().c_str(),
-                     cases + 1, out["shard"]["holds"].size());
-      ++cases;
+                     cases + skipped + 1, out["shard"]["holds"].size());
       const std::string verdict = record_verdict(record);
+      if (verdict == "skip") {
+        ++skipped;
+        if (!o->quiet)
+          std::printf("%s  skipped: %s\n", key.c_str(), record.value("skipped", "").c_str());
+        return;
+      }
+      ++cases;
       failed += verdict == conformance::kVerdictFail;
       limits += verdict == conformance::kVerdictLimit;
       const bool finished = verdict == conformance::kVerdictPass ||
@@ -297,9 +355,33 @@ void add_conform(CLI::App& app) {
     const std::map<std::string, nlohmann::json> records = run_supervised(
         supervised, o->supervision,
         [&](const std::string& key) { return run_case(*by_key.at(key)); }, show, journal);
+    // A renderer with an expectation file counts against the run by its changes alone, as
+    // deqp-runner's do: a case that does not do what its file says (an unexpected pass too).
+    std::vector<std::string> changes;
+    int expected_failures = 0;
     for (const Case& c : held) {
       nlohmann::json record = records.at(c.key);
       record.erase("table");
+      const std::string verdict = record_verdict(record);
+      if (const auto e = expectations.find(c.backend->name()); e != expectations.end()) {
+        const std::string outcome = e->second.outcome(c.key, verdict);
+        record["expectation"] = {{"expected", e->second.expected(c.key)}, {"outcome", outcome}};
+        if (conformance::Expectations::change(outcome))
+          changes.push_back(c.key + ": " + outcome + " (expected " + e->second.expected(c.key) +
+                            ")");
+        else
+          expected_failures += verdict != conformance::kVerdictPass && verdict != "skip" &&
+                               verdict != conformance::kVerdictLimit;
+      }
+      if (verdict == "skip") {
+        out["skipped"].push_back({{"backend", c.backend->name()},
+                                  {"scene", c.scene->name},
+                                  {"method", to_string(c.method)},
+                                  {"reason", record["skipped"]}});
+        if (record.contains("expectation"))
+          out["skipped"].back()["expectation"] = record["expectation"];
+        continue;
+      }
       // A case its worker failed: the supervisor's record, named.
       if (!record.contains("backend")) {
         record["backend"] = c.backend->name();
@@ -307,6 +389,15 @@ void add_conform(CLI::App& app) {
         record["method"] = to_string(c.method);
       }
       out["cases"].push_back(std::move(record));
+    }
+    if (!expectations.empty()) {
+      out["changes"] = changes;
+      std::vector<std::string> keys;
+      for (const Case& c : held) keys.push_back(c.key);
+      for (const auto& [name, e] : expectations)
+        for (const std::string& stale : e.unseen(keys))
+          std::fprintf(stderr, "conform: %s lists %s, which this run did not have\n",
+                       e.file().c_str(), stale.c_str());
     }
     if (!no_images.empty())
       out["unmeasured"] =
@@ -320,6 +411,17 @@ void add_conform(CLI::App& app) {
                                  .c_str()
                            : "",
                 o->json.c_str());
+    const auto case_skips =
+        std::count_if(out["skipped"].begin(), out["skipped"].end(),
+                      [](const nlohmann::json& s) { return s.contains("scene"); });
+    if (case_skips > 0)
+      std::printf("%d cases skipped (their renderer cannot render them; see \"skipped\" in %s)\n",
+                  static_cast<int>(case_skips), o->json.c_str());
+    if (!expectations.empty()) {
+      std::printf("%zu changes against the expectation files%s\n", changes.size(),
+                  changes.empty() ? "" : ":");
+      for (const std::string& change : changes) std::printf("    %s\n", change.c_str());
+    }
     if (!no_images.empty())
       say_left_out("conform",
                    o->error_images.empty() ? "Yee's perceptual check"
@@ -329,8 +431,11 @@ void add_conform(CLI::App& app) {
                             ? ""
                             : "; `flatmarch conform --error-images DIR` on a machine with "
                               "OpenImageIO (ci/install-deps.sh installs it) draws the images"));
-    if (failed || unfinished)
-      throw ConformanceFailure(std::to_string(failed + unfinished) + " of " +
+    if (!changes.empty())
+      throw ConformanceFailure(std::to_string(changes.size()) +
+                               " cases changed against their expectation files");
+    if (failed + unfinished > expected_failures)
+      throw ConformanceFailure(std::to_string(failed + unfinished - expected_failures) + " of " +
                                std::to_string(cases) + " cases failed or did not finish");
     if (limits && o->strict)
       throw ConformanceFailure(std::to_string(limits) + " of " + std::to_string(cases) +

@@ -60,14 +60,22 @@ void add_import_peer(CLI::App& app) {
       "file's redundant fields (normals, translation vectors, affine maps) disagree with the maps\n"
       "derived here, and what was converted approximately, moved, dropped or ignored.");
   struct Options {
-    std::string file, out, report;
+    std::string file, out, report, view = "start", name;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("FILE", o->file, "The app's geometry (JSON)")->required();
   cmd->add_option("-o,--output", o->out, "Write the scene here instead of to stdout");
   cmd->add_option("--report-json", o->report, "Also write the findings as JSON here");
+  cmd->add_option("--view", o->view,
+                  "The camera: start (the app's initial view) or benchmark (the view its shaders "
+                  "are timed from: its start + (0.5, 0, 0.5), looking along (1, 0, 0.3))")
+      ->check(CLI::IsMember({"start", "benchmark"}))
+      ->capture_default_str();
+  cmd->add_option("--name", o->name, "The scene's name (default: the app's id, in snake case)");
   cmd->callback([o] {
-    const PeerImport result = import_peer_file(o->file);
+    PeerImport result = import_peer_file(o->file);
+    if (o->view == "benchmark") use_benchmark_view(result.scene);
+    if (!o->name.empty()) result.scene["name"] = o->name;
     if (o->out.empty())
       std::cout << pretty(result.scene) << "\n";
     else

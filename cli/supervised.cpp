@@ -42,6 +42,8 @@ nlohmann::json record_or_error(const std::function<nlohmann::json()>& run) {
     return run();
   } catch (const std::bad_alloc&) {
     throw;
+  } catch (const CaseSkipped& e) {
+    return {{"skipped", e.what()}};
   } catch (const std::exception& e) {
     return {{"error", e.what()}};
   }
@@ -52,6 +54,7 @@ bool unfinished_record(const nlohmann::json& record) {
 }
 
 std::string record_verdict(const nlohmann::json& record) {
+  if (record.contains("skipped")) return "skip";
   if (record.contains("error") && !record.contains("verdict")) return "error";
   if (record.contains("verdict")) return record["verdict"].get<std::string>();
   return "error";

@@ -76,7 +76,8 @@ void run_alongside(
 // lines its worker wrote on its standard error, indented; for a table.
 std::string unfinished_lines(const std::string& key, const nlohmann::json& record);
 
-// The record of a case run here by `run`: its own, or {"error": what} where it threw. A
+// The record of a case run here by `run`: its own, {"skipped": why} where its renderer cannot
+// render it (CaseSkipped), or {"error": what} where it threw. A
 // std::bad_alloc passes on: a worker answers it out_of_memory (serve_cases).
 nlohmann::json record_or_error(const std::function<nlohmann::json()>& run);
 

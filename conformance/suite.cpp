@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "backends/scalar/scalar.hpp"
+#include "conformance/external.hpp"
 #include "conformance/vocabulary.hpp"
 #include "scene/scene.hpp"
 
@@ -269,11 +270,19 @@ const std::vector<std::pair<Ray, Trace>>& Suite::probes(const Scene& scene, int 
   return it->second;
 }
 
-CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchParams& params,
+CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchParams& asked,
                       int width, int height) {
   CaseResult r;
   r.backend = backend.name();
   r.scene = scene.name;
+  // A renderer we did not write is judged as marching with the parameters it has built in, and
+  // on what it gives (ExternalInfo): what it does not give is left unmeasured, saying why.
+  const ExternalInfo* external = backend.external();
+  const MarchParams params = external ? external->marches_with(asked) : asked;
+  const auto unmeasured = [&](const std::string& check, const std::string& why) {
+    r.unmeasured.push_back(check);
+    r.unmeasured_why[check] = why;
+  };
   r.params = params;
   r.width = width;
   r.height = height;
@@ -283,27 +292,65 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   const FrameTruth& exact = truth(scene, params, width, height);
   r.delta = exact.delta;
   const auto started = std::chrono::steady_clock::now();
-  const Frame got = backend.render(scene, scene.camera, width, height, params, {});
+  Frame got = backend.render(scene, scene.camera, width, height, params, {});
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (external) {
+    r.external = *external;
+    if (const std::optional<double> s = backend.last_frame_seconds()) r.seconds = *s;
+    // A channel it does not give is the truth's, so that the others are compared on their own.
+    const std::string own = "its manifest does not list ";
+    if (!external->hit) {
+      got.hit = exact.frame.hit;
+      for (const char* check : {"hit_rate", "failures"}) unmeasured(check, own + "hit");
+    }
+    if (!external->crossings) {
+      got.crossings = exact.frame.crossings;
+      unmeasured("crossings_rate", own + "crossings");
+    }
+    if (!external->t) {
+      got.t = exact.frame.t;
+      unmeasured("t.exceeded", own + "t");
+    }
+    if (!external->steps) std::fill(got.steps.begin(), got.steps.end(), 0.0f);
+  }
 
   r.aov = compare_aovs(got, exact, scene.scale);
   const double pixels = static_cast<double>(r.aov.pixels);
   const double decided = static_cast<double>(std::max<size_t>(r.aov.decided(), 1));
-  add_check(r, "hit_rate", r.aov.hit_rate(), t.hit_rate, true);
-  add_check(r, "crossings_rate", r.aov.crossings_rate(), t.crossings_rate, true);
+  const auto measured = [&](const std::string& check) {
+    return std::find(r.unmeasured.begin(), r.unmeasured.end(), check) == r.unmeasured.end();
+  };
+  if (measured("hit_rate")) add_check(r, "hit_rate", r.aov.hit_rate(), t.hit_rate, true);
+  if (measured("crossings_rate"))
+    add_check(r, "crossings_rate", r.aov.crossings_rate(), t.crossings_rate, true);
   add_check(r, "ambiguous", static_cast<double>(r.aov.ambiguous) / pixels, t.ambiguous_max, false);
-  add_check(r, "t.exceeded", r.aov.t_exceeded_share(), t.t_exceeded_max, false);
-  add_check(r, "most_steps", r.aov.most_steps, params.max_steps, false);
-  for (int c = 0; c < kFailureClasses; ++c)
-    add_check(r, std::string("failures.") + to_string(static_cast<Failure>(c)),
-              static_cast<double>(r.aov.failures[static_cast<size_t>(c)]) / decided,
-              t.failure_max[static_cast<size_t>(c)], false);
+  if (measured("t.exceeded"))
+    add_check(r, "t.exceeded", r.aov.t_exceeded_share(), t.t_exceeded_max, false);
+  if (!external) add_check(r, "most_steps", r.aov.most_steps, params.max_steps, false);
+  if (measured("failures"))
+    for (int c = 0; c < kFailureClasses; ++c)
+      add_check(r, std::string("failures.") + to_string(static_cast<Failure>(c)),
+                static_cast<double>(r.aov.failures[static_cast<size_t>(c)]) / decided,
+                t.failure_max[static_cast<size_t>(c)], false);
 
-  r.image = compare_images(got, exact.frame, exact.ambiguity, t.image);
-  add_check(r, "image.failpercent", 100.0 * static_cast<double>(r.image.fail) / pixels,
-            t.image.failpercent, false);
-  add_check(r, "image.max_error", r.image.max_error, t.image.hardfail, false);
-  if (r.image.perceptual_measured)
+  // The truth's colours in the look the renderer declares.
+  const Frame& truth_colour =
+      external ? looked(scene, params, width, height, external->look) : exact.frame;
+  const bool colour = !external || external->colour;
+  if (!colour) {
+    got.rgb = truth_colour.rgb;
+    for (const char* check : {"image", "colour"})
+      unmeasured(check, external->look == "none" ? "its manifest's look is none"
+                                                 : "its manifest does not list colour");
+  }
+  r.image = compare_images(got, truth_colour, exact.ambiguity, t.image);
+  if (colour) {
+    add_check(r, "image.failpercent", 100.0 * static_cast<double>(r.image.fail) / pixels,
+              t.image.failpercent, false);
+    add_check(r, "image.max_error", r.image.max_error, t.image.hardfail, false);
+  }
+  if (!colour) {
+  } else if (r.image.perceptual_measured)
     add_check(r, "image.perceptual_failpercent",
               100.0 * static_cast<double>(r.image.perceptual) / pixels,
               t.image.perceptual_failpercent, false);
@@ -313,8 +360,9 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
     r.warnings.push_back(std::to_string(r.image.warn) + " pixels differ by more than " +
                          std::to_string(t.image.warn));
   std::vector<uint8_t> colour_failing;
-  r.regions = compare_regions(got, exact.frame, exact.ambiguity, t.colour,
+  r.regions = compare_regions(got, truth_colour, exact.ambiguity, t.colour,
                               static_cast<int>(scene.objects.size()), &colour_failing);
+  if (!colour) r.regions.clear();
   for (const RegionColour& region : r.regions) {
     std::string name = region.name();
     std::replace(name.begin(), name.end(), ' ', '_');
@@ -325,8 +373,16 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   if (keep_classes_)
     r.pixel_classes = classify_pixels(got, exact.frame, exact.ambiguity, colour_failing);
 
-  const Frame& ref = reference(scene, params, width, height);
   r.steps = step_stats(got.steps);
+  if (external) {
+    // Its steps are its own loop's count, not our kernel's: shown, not compared.
+    unmeasured("steps", external->steps ? "an external renderer's steps count its own loop"
+                                        : "its manifest does not list steps");
+    unmeasured("traces", "an external renderer traces no probe rays");
+    judge(r, unpushed_ambiguity(r, scene, width, height));
+    return r;
+  }
+  const Frame& ref = reference(scene, params, width, height);
   r.reference_steps = step_stats(ref.steps);
   r.steps_ks = ks_statistic(got.steps, ref.steps);
   add_check(r, "steps.ks", r.steps_ks, t.steps_ks_max, false);
@@ -350,22 +406,39 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   add_check(r, "traces.error", trace_error / scene.scale, t.trace_error, false);
   if (static_cast<int>(r.traces.size()) < t.probe_rays)
     r.warnings.push_back("only " + std::to_string(r.traces.size()) + " generic probe rays found");
-  double unpushed = 0.0;
-  if (params.method != Method::analytic && !r.passed) {
-    MarchParams analytic = params;
-    analytic.method = Method::analytic;
-    unpushed = static_cast<double>(truth(scene, analytic, width, height).ambiguous()) / pixels;
-  }
-  judge(r, unpushed);
+  judge(r, unpushed_ambiguity(r, scene, width, height));
   return r;
+}
+
+double Suite::unpushed_ambiguity(const CaseResult& r, const Scene& scene, int width, int height) {
+  if (r.params.method == Method::analytic || r.passed) return 0.0;
+  MarchParams analytic = r.params;
+  analytic.method = Method::analytic;
+  return static_cast<double>(truth(scene, analytic, width, height).ambiguous()) /
+         static_cast<double>(std::max<size_t>(r.aov.pixels, 1));
+}
+
+const Frame& Suite::looked(const Scene& scene, const MarchParams& params, int width, int height,
+                           const std::string& look) {
+  const FrameTruth& exact = truth(scene, params, width, height);
+  const std::string k = key(scene, params, width, height, false) + "|" + look;
+  auto it = looks_.find(k);
+  if (it == looks_.end()) {
+    Frame frame = exact.frame;
+    if (std::optional<Channel> rgb = look_colours(look, scene, scene.camera, width, height, params))
+      frame.rgb = std::move(*rgb);
+    it = looks_.emplace(k, std::move(frame)).first;
+  }
+  return it->second;
 }
 
 json unmeasured_json(const CaseResult& r) {
   json checks = json::array();
   for (const std::string& name : r.unmeasured)
-    checks.push_back(
-        {{"check", name},
-         {"why", name == "image.perceptual_failpercent" ? r.image.perceptual_why : std::string()}});
+    checks.push_back({{"check", name},
+                      {"why", name == "image.perceptual_failpercent" ? r.image.perceptual_why
+                              : r.unmeasured_why.count(name)         ? r.unmeasured_why.at(name)
+                                                                     : std::string()}});
   return checks;
 }
 
@@ -454,6 +527,7 @@ json to_json(const CaseResult& r) {
       {"colour", colour},
       {"warnings", r.warnings},
       {"unmeasured", unmeasured_json(r)},
+      {"external", r.external ? external_json(*r.external) : json(nullptr)},
       {"thresholds", to_json(r.thresholds)}};
 }
 

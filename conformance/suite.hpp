@@ -51,6 +51,10 @@ struct CaseResult {
   // Checks left out where what they need is missing here (Yee's metric without the image
   // module: ImageComparison::perceptual_why), by name; the verdict is the other checks'.
   std::vector<std::string> unmeasured;
+  std::map<std::string, std::string> unmeasured_why;  // where not the perceptual metric's
+  // A renderer we did not write (Backend::external): what it is; `seconds` is its command's,
+  // start-up and all.
+  std::optional<ExternalInfo> external;
   std::vector<std::string> warnings;
   bool passed = true;  // every check within its threshold
   Verdict verdict = Verdict::pass;
@@ -116,12 +120,18 @@ class Suite {
   const Frame& reference(const Scene& scene, const MarchParams& params, int width, int height);
   const std::vector<std::pair<Ray, Trace>>& probes(const Scene& scene, int count, int events,
                                                    double max_distance);
+  // The oracle's frame with its colours in `look` (external.hpp's look_colours).
+  const Frame& looked(const Scene& scene, const MarchParams& params, int width, int height,
+                      const std::string& look);
+  // The ambiguous share of a case's frame had its method not pushed (judge's limit).
+  double unpushed_ambiguity(const CaseResult& r, const Scene& scene, int width, int height);
 
   nlohmann::json thresholds_;
   std::optional<MarchParams> mask_;
   bool keep_classes_ = false;
   std::map<std::string, FrameTruth> truths_;
   std::map<std::string, Frame> references_;
+  std::map<std::string, Frame> looks_;
   std::map<std::string, std::vector<std::pair<Ray, Trace>>> probes_;
 };
 

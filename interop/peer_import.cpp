@@ -897,7 +897,24 @@ PeerImport import_peer(const nlohmann::json& peer, const std::string& file) {
 }
 
 PeerImport import_peer_file(const std::filesystem::path& path) {
-  return import_peer(read_json_file(path), path.string());
+  PeerImport result = import_peer(read_json_file(path), path.string());
+  result.scene["imported_from"] = std::filesystem::absolute(path).lexically_normal().string();
+  return result;
+}
+
+bool is_peer_geometry(const nlohmann::json& doc) {
+  return doc.is_object() && doc.contains("vertices") && doc.contains("gluing") &&
+         !doc.contains("polygons");
+}
+
+void use_benchmark_view(nlohmann::ordered_json& scene) {
+  nlohmann::ordered_json& camera = scene["camera"];
+  auto position = camera["position"].get<std::vector<double>>();
+  position.at(0) += 0.5;
+  position.at(1) += 0.5;
+  camera["position"] = position;
+  camera["yaw_deg"] = std::atan2(0.3, 1.0) * 180.0 / std::acos(-1.0);
+  camera["pitch_deg"] = 0.0;
 }
 
 nlohmann::ordered_json findings_json(const std::vector<PeerFinding>& findings) {

@@ -41,7 +41,19 @@ struct PeerImport {
 // A malformed peer file throws SceneError with the JSON pointer into the peer file. `file`
 // names the source in errors and findings; its stem, in snake case, names the scene.
 PeerImport import_peer(const nlohmann::json& peer, const std::string& file);
+// import_peer of a file; the scene says where it came from ("imported_from", the file's absolute
+// path), for an external renderer that reads the app's format (docs/external.md).
 PeerImport import_peer_file(const std::filesystem::path& path);
+
+// Whether a JSON document is a geometry of the app rather than a scene of ours (it has the app's
+// "vertices" and "gluing", not our "polygons").
+bool is_peer_geometry(const nlohmann::json& doc);
+
+// Turns an imported scene's camera to the view the benchmarks take of the app
+// (../shared/peer-shaders.md): from the app's start point + (0.5, 0, 0.5), looking along
+// normalize(1, 0, 0.3), level, which is here the start moved by (0.5, 0.5, 0) and turned to yaw
+// atan2(0.3, 1). The field of view stays the app's.
+void use_benchmark_view(nlohmann::ordered_json& scene);
 
 nlohmann::ordered_json findings_json(const std::vector<PeerFinding>& findings);
 

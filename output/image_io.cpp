@@ -92,7 +92,13 @@ void write_aov_exr(const Frame& frame, const std::filesystem::path& exr) {
 
 Frame read_aov_exr(const std::filesystem::path& exr) {
   Frame frame;
-  image_library().read_aov_exr(exr.string(), frame);
+  image_library().read_aov_exr(exr.string(), frame, nullptr);
+  return frame;
+}
+
+Frame read_exr_channels(const std::filesystem::path& exr, unsigned& present) {
+  Frame frame;
+  image_library().read_aov_exr(exr.string(), frame, &present);
   return frame;
 }
 

@@ -20,6 +20,9 @@ void write_aov_exr(const Frame& frame, const std::filesystem::path& exr);
 
 // Reads an EXR written by write_aov_exr back into a frame.
 Frame read_aov_exr(const std::filesystem::path& exr);
+// Reads any EXR's channels of those names (another program's): a channel it lacks is NaN, and
+// bit k of `present` says whether channel k (R, G, B, steps, crossings, hit, t) was there.
+Frame read_exr_channels(const std::filesystem::path& exr, unsigned& present);
 
 // A PNG's colour as written: 8-bit sRGB, 3 bytes a pixel, rows from the top.
 struct Png {

@@ -22,8 +22,10 @@ struct ImageLibrary {
   // The colour as an 8-bit sRGB PNG (clamped); every channel as a float EXR.
   void (*write_png)(const Frame& frame, const std::string& path) = nullptr;
   void (*write_aov_exr)(const Frame& frame, const std::string& path) = nullptr;
-  // An EXR written by write_aov_exr, into `frame` (resized).
-  void (*read_aov_exr)(const std::string& path, Frame& frame) = nullptr;
+  // An EXR written by write_aov_exr, into `frame` (resized). With `present` null every channel
+  // must be there; else a channel the file lacks is NaN and bit k of *present says whether
+  // channel k (R, G, B, steps, crossings, hit, t) was there (another program's EXR).
+  void (*read_aov_exr)(const std::string& path, Frame& frame, unsigned* present) = nullptr;
   // A PNG's colour as written, 8-bit sRGB, 3 bytes a pixel (rows from the top).
   void (*read_png)(const std::string& path, std::vector<uint8_t>& rgb, int& width,
                    int& height) = nullptr;
@@ -33,7 +35,7 @@ struct ImageLibrary {
 };
 
 // Changes whenever ImageLibrary or a type it passes changes.
-constexpr int kImageLibraryAbi = 3;
+constexpr int kImageLibraryAbi = 4;
 
 // The module, loaded on first call from $FLATMARCH_MODULE_DIR (there alone, where it is set),
 // else lib/flatmarch beside the program's folder (dynamic_library.hpp's kModuleFolder); throws

@@ -2,6 +2,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include <limits>
 #include <stdexcept>
 
 #include "output/image_library.hpp"
@@ -49,7 +50,7 @@ void write_aov_exr(const Frame& frame, const std::string& exr) {
   check(buf.write(exr), buf, exr, "write");
 }
 
-void read_aov_exr(const std::string& exr, Frame& frame) {
+void read_aov_exr(const std::string& exr, Frame& frame, unsigned* present) {
   OIIO::ImageBuf buf(exr);
   check(buf.read(0, 0, true, OIIO::TypeDesc::FLOAT), buf, exr, "read");
   // OpenEXR keeps channels sorted by name, so look each one up.
@@ -57,14 +58,21 @@ void read_aov_exr(const std::string& exr, Frame& frame) {
   int index[kAovCount];
   for (int k = 0; k < kAovCount; ++k) {
     index[k] = spec.channelindex(kAovChannels[k]);
-    if (index[k] < 0) throw std::runtime_error(exr + ": no channel " + kAovChannels[k]);
+    if (index[k] < 0 && !present) throw std::runtime_error(exr + ": no channel " + kAovChannels[k]);
+  }
+  if (present) {
+    *present = 0;
+    for (int k = 0; k < kAovCount; ++k) *present |= index[k] >= 0 ? 1u << k : 0u;
   }
   frame = Frame(spec.width, spec.height);
   std::vector<float> pixel(static_cast<size_t>(spec.nchannels));
   for (int j = 0; j < frame.height; ++j)
     for (int i = 0; i < frame.width; ++i) {
       buf.getpixel(i, j, pixel.data(), spec.nchannels);
-      const auto channel = [&](int k) { return pixel[static_cast<size_t>(index[k])]; };
+      const auto channel = [&](int k) {
+        return index[k] < 0 ? std::numeric_limits<float>::quiet_NaN()
+                            : pixel[static_cast<size_t>(index[k])];
+      };
       const size_t px = frame.pixel(i, j);
       for (int k = 0; k < 3; ++k) frame.rgb[3 * px + static_cast<size_t>(k)] = channel(k);
       frame.steps[px] = channel(3);

@@ -417,11 +417,19 @@ void read_look(const JsonNode& root, Scene& scene) {
 Scene scene_from_json(const nlohmann::json& doc, const std::string& file) {
   const JsonNode root(doc, "", file);
   root.allow_keys({"name", "description", "polygons", "gluings", "boundary", "boundaries", "height",
-                   "period", "floor", "objects", "singularities", "vertices", "camera", "look"});
+                   "period", "floor", "objects", "singularities", "vertices", "camera", "look",
+                   "imported_from"});
   Scene scene;
   scene.name =
       root.has("name") ? root["name"].string() : std::filesystem::path(file).stem().string();
   if (root.has("description")) scene.description = root["description"].string();
+  if (root.has("imported_from")) {
+    // The app's file it was converted from, relative to this scene's folder where relative.
+    std::filesystem::path from = root["imported_from"].string();
+    if (from.empty()) root["imported_from"].fail("an empty path");
+    if (from.is_relative()) from = std::filesystem::path(file).parent_path() / from;
+    scene.imported_from = from.lexically_normal().string();
+  }
   if (root.has("height")) scene.height = root["height"].positive();
   if (root.has("period")) scene.period = root["period"].positive();
   if (root.has("floor")) scene.floor = root["floor"].boolean();
@@ -484,7 +492,9 @@ Scene parse_scene(std::string_view text, const std::string& file) {
 }
 
 Scene load_scene(const std::filesystem::path& path) {
-  return scene_from_json(read_json_file(path), path.string());
+  Scene scene = scene_from_json(read_json_file(path), path.string());
+  scene.source_file = path.string();
+  return scene;
 }
 
 }  // namespace flatmarch

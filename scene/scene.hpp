@@ -232,6 +232,11 @@ struct Scene {
   std::vector<Marker> markers;
   Camera camera;
   Look look;
+  // Where it came from: the file it was read from (empty for a scene made in code), and the web
+  // app's geometry file it was converted from (`"imported_from"`, written by import-peer; empty
+  // otherwise), which an external renderer that reads the app's format renders instead.
+  std::string source_file;
+  std::string imported_from;
 
   // Derived.
   std::vector<VertexClass> vertex_classes;
