@@ -30,13 +30,6 @@ std::string read(const std::filesystem::path& file) {
 
 }  // namespace
 
-struct PeerApp::Program {
-  const gl::Api& gl;
-  GLuint program;
-  GLint resolution, time, position, front, up;
-  ~Program() { gl.DeleteProgram(program); }
-};
-
 Scene peer_scene(const PeerView& view) {
   const std::string file = std::string(view.id) + ".json";
   const PeerImport imported = import_peer_file(std::filesystem::path(FLATMARCH_SOURCE_DIR) /
@@ -71,11 +64,7 @@ std::string app_shader(const std::filesystem::path& folder, const std::string& i
   return read(folder / (id + ".frag"));
 }
 
-PeerApp::PeerApp(const std::filesystem::path& folder, const std::string& device)
-    : folder_(folder), start_(app_starts(folder)) {
-  context_ = gl::make_context(device, gl::Profile::compatibility);
-  const gl::Context::Current current(*context_);
-  const gl::Api& gl = context_->api();
+AppTriangle::AppTriangle(const gl::Api& gl) : gl_(gl) {
   const float triangle[] = {-1.0f, -1.0f, 3.0f, -1.0f, -1.0f, 3.0f};
   gl.GenVertexArrays(1, &vertex_array_);
   gl.BindVertexArray(vertex_array_);
@@ -86,12 +75,53 @@ PeerApp::PeerApp(const std::filesystem::path& folder, const std::string& device)
   gl.EnableVertexAttribArray(0);
 }
 
+AppTriangle::~AppTriangle() {
+  gl_.DeleteBuffers(1, &vertices_);
+  gl_.DeleteVertexArrays(1, &vertex_array_);
+}
+
+void AppTriangle::bind() const {
+  gl_.BindVertexArray(vertex_array_);
+}
+
+AppProgram::AppProgram(const gl::Api& gl, const std::string& fragment)
+    : gl_(gl),
+      program_(gl::link_program(gl, kVertexShader, "#version 120\n" + fragment)),
+      resolution_(gl.GetUniformLocation(program_, "iResolution")),
+      time_(gl.GetUniformLocation(program_, "iTime")),
+      position_(gl.GetUniformLocation(program_, "rayMarchCamPos")),
+      front_(gl.GetUniformLocation(program_, "rayMarchCamFront")),
+      up_(gl.GetUniformLocation(program_, "rayMarchCamUp")) {}
+
+AppProgram::~AppProgram() {
+  gl_.DeleteProgram(program_);
+}
+
+void AppProgram::draw(const AppTriangle& triangle, const AppView& view, int width,
+                      int height) const {
+  gl_.UseProgram(program_);
+  gl_.Uniform2f(resolution_, static_cast<float>(width), static_cast<float>(height));
+  gl_.Uniform1f(time_, 0.0f);
+  gl_.Uniform3f(position_, view.from.x, view.from.y, view.from.z);
+  gl_.Uniform3f(front_, view.front.x, view.front.y, view.front.z);
+  gl_.Uniform3f(up_, view.up.x, view.up.y, view.up.z);
+  gl_.Viewport(0, 0, width, height);
+  triangle.bind();
+  gl_.DrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+PeerApp::PeerApp(const std::filesystem::path& folder, const std::string& device)
+    : folder_(folder), start_(app_starts(folder)) {
+  context_ = gl::make_context(device, gl::Profile::compatibility);
+  const gl::Context::Current current(*context_);
+  triangle_ = std::make_unique<AppTriangle>(context_->api());
+}
+
 PeerApp::~PeerApp() {
   const gl::Context::Current current(*context_);
   const gl::Api& gl = context_->api();
   programs_.clear();
-  gl.DeleteBuffers(1, &vertices_);
-  gl.DeleteVertexArrays(1, &vertex_array_);
+  triangle_.reset();
   if (framebuffer_ != 0) gl.DeleteFramebuffers(1, &framebuffer_);
   if (texture_ != 0) gl.DeleteTextures(1, &texture_);
 }
@@ -100,19 +130,9 @@ std::string PeerApp::renderer() const {
   return context_->device().renderer + ", " + context_->device().version;
 }
 
-PeerApp::Program& PeerApp::program(const std::string& id) {
+AppProgram& PeerApp::program(const std::string& id) {
   auto& p = programs_[id];
-  if (!p) {
-    const gl::Api& gl = context_->api();
-    const GLuint program =
-        gl::link_program(gl, kVertexShader, "#version 120\n" + app_shader(folder_, id));
-    // Made in place: a temporary Program would delete the GL program as it goes.
-    p.reset(new Program{gl, program, gl.GetUniformLocation(program, "iResolution"),
-                        gl.GetUniformLocation(program, "iTime"),
-                        gl.GetUniformLocation(program, "rayMarchCamPos"),
-                        gl.GetUniformLocation(program, "rayMarchCamFront"),
-                        gl.GetUniformLocation(program, "rayMarchCamUp")});
-  }
+  if (!p) p = std::make_unique<AppProgram>(context_->api(), app_shader(folder_, id));
   return *p;
 }
 
@@ -135,17 +155,7 @@ void PeerApp::frame(const std::string& id, int width, int height) {
     height_ = height;
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
-  const Program& p = program(id);
-  const AppView view = app_view(start_[id]);
-  gl.UseProgram(p.program);
-  gl.Uniform2f(p.resolution, static_cast<float>(width), static_cast<float>(height));
-  gl.Uniform1f(p.time, 0.0f);
-  gl.Uniform3f(p.position, view.from.x, view.from.y, view.from.z);
-  gl.Uniform3f(p.front, view.front.x, view.front.y, view.front.z);
-  gl.Uniform3f(p.up, view.up.x, view.up.y, view.up.z);
-  gl.Viewport(0, 0, width, height);
-  gl.BindVertexArray(vertex_array_);
-  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  program(id).draw(*triangle_, app_view(start_[id]), width, height);
   std::vector<unsigned char> pixels(4 * static_cast<size_t>(width) * static_cast<size_t>(height));
   gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
   if (const std::string e = gl::errors(gl); !e.empty())

@@ -1,6 +1,7 @@
 // The original web app's shaders (Lander & Taha's RayMarchingFlatSurfaces), regenerated locally
 // as ../shared/peer-shaders.md says (they are not ours to ship), drawn on the same OpenGL device
-// as the opengl backend, so that both are timed in one run.
+// as the opengl backend, so that both are timed in one run. peer_adapter draws them with the same
+// pieces (AppTriangle, AppProgram) to judge the app under the external renderer protocol.
 #pragma once
 
 #include <filesystem>
@@ -48,6 +49,39 @@ std::map<std::string, glm::vec3> app_starts(const std::filesystem::path& folder)
 // FOLDER/ID.frag, the app's shader of a geometry, as it comes (GLSL without a version line).
 std::string app_shader(const std::filesystem::path& folder, const std::string& id);
 
+// The full-screen triangle the app's shaders are drawn over, made on the current compatibility
+// context (generic attribute 0 is gl_Vertex there).
+class AppTriangle {
+ public:
+  explicit AppTriangle(const gl::Api& gl);
+  ~AppTriangle();
+  AppTriangle(const AppTriangle&) = delete;
+  AppTriangle& operator=(const AppTriangle&) = delete;
+  void bind() const;
+
+ private:
+  const gl::Api& gl_;
+  GLuint vertices_ = 0, vertex_array_ = 0;
+};
+
+// One of the app's fragment shaders as it generates them (GLSL 1.20 without a version line),
+// linked on the current compatibility context. Throws std::runtime_error with the compiler's log.
+class AppProgram {
+ public:
+  AppProgram(const gl::Api& gl, const std::string& fragment);
+  ~AppProgram();
+  AppProgram(const AppProgram&) = delete;
+  AppProgram& operator=(const AppProgram&) = delete;
+
+  // Draws a width x height frame of `view` (iTime 0) over `triangle` into the bound framebuffer.
+  void draw(const AppTriangle& triangle, const AppView& view, int width, int height) const;
+
+ private:
+  const gl::Api& gl_;
+  GLuint program_;
+  GLint resolution_, time_, position_, front_, up_;
+};
+
 class PeerApp {
  public:
   // Reads FOLDER/meta.json and makes a compatibility-profile context on `device` (as --device).
@@ -66,14 +100,14 @@ class PeerApp {
   std::string renderer() const;
 
  private:
-  struct Program;
-  Program& program(const std::string& id);
+  AppProgram& program(const std::string& id);
 
   std::filesystem::path folder_;
   std::map<std::string, glm::vec3> start_;  // initialPosition per id
   std::unique_ptr<gl::Context> context_;
-  std::map<std::string, std::unique_ptr<Program>> programs_;
-  unsigned framebuffer_ = 0, texture_ = 0, vertices_ = 0, vertex_array_ = 0;
+  std::unique_ptr<AppTriangle> triangle_;
+  std::map<std::string, std::unique_ptr<AppProgram>> programs_;
+  unsigned framebuffer_ = 0, texture_ = 0;
   int width_ = 0, height_ = 0;
 };
 

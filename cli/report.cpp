@@ -133,7 +133,7 @@ void add_report(CLI::App& app) {
       "same check against reports/baseline.json when this run was measured as it was, else why\n"
       "not. --previous adds the change per case since an earlier run.");
   struct Options {
-    std::vector<std::string> results, backends, skip_backends, scenes, methods;
+    std::vector<std::string> results, backends, skip_backends, scenes, methods, externals;
     std::vector<std::string> galleries = {data_folder("scenes")};
     std::string out = "reports/out", progress_log, size, conform_size = "160x90", sweep_size,
                 sweep_backend;
@@ -211,6 +211,7 @@ void add_report(CLI::App& app) {
       *cmd, o->params,
       {.eps = true, .offset = true, .max_steps = true, .max_distance = false, .omega = false});
   add_backend_options(*cmd, o->backend_options);
+  add_external_option(*cmd, o->externals);
   add_supervision_options(*cmd, o->supervision, "OUT/results.json.journal");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress");
   cmd->add_option("--compile-jobs", o->compile_jobs,
@@ -247,11 +248,16 @@ void add_report(CLI::App& app) {
     }
     check_march_params(o->params);
     check_backend_options(o->backend_options);
+    const std::vector<std::string> externals = register_externals(o->externals);
     reports::ReportOptions r;
     r.matrix.params = o->params;
     r.matrix.backend_options = o->backend_options;
     r.matrix.methods = parse_methods(o->methods);
     if (!o->backends.empty()) r.matrix.backends = o->backends;
+    for (const std::string& name : externals)
+      if (std::find(r.matrix.backends.begin(), r.matrix.backends.end(), name) ==
+          r.matrix.backends.end())
+        r.matrix.backends.push_back(name);
     for (const std::string& b : o->skip_backends) {
       const auto at = std::find(r.matrix.backends.begin(), r.matrix.backends.end(), b);
       if (at == r.matrix.backends.end())
@@ -394,6 +400,12 @@ void add_report(CLI::App& app) {
         // planned) says so, and why, rather than coming back empty.
         const std::vector<std::string> measured = reports::report_part_keys(part);
         if (std::find(measured.begin(), measured.end(), key) != measured.end()) return part;
+        // A case its renderer cannot render (an external one's): skipped, in the part.
+        if (part.contains("matrix"))
+          for (const json& skip : part["matrix"]["skipped"])
+            if (skip.contains("scene") &&
+                reports::matrix_case_key(skip["backend"], skip["method"], skip["scene"]) == key)
+              return part;
         std::string why;
         for (const json& skip : backends->skipped)
           why +=

@@ -1,5 +1,7 @@
 #include "reports/matrix.hpp"
 
+#include "conformance/external.hpp"
+
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -393,6 +395,22 @@ bool matrix_measures(const MatrixOptions& o, const std::string& backend, const s
   return !has(o.sampled_backends, backend) || has(o.sample_cases, scene + "/" + method);
 }
 
+namespace {
+
+// Why a renderer we did not write (Backend::external) cannot render a case: a method it has not,
+// a scene it cannot read; empty for one it can, and for every case of ours. Such a case is
+// skipped, saying why.
+std::string cannot(const Backend& backend, Method m, const Scene& scene) {
+  const ExternalInfo* info = backend.external();
+  if (!info) return {};
+  const std::vector<Method> methods = backend.methods();
+  if (std::find(methods.begin(), methods.end(), m) == methods.end())
+    return "it renders no " + std::string(to_string(m)) + " cases (its manifest's methods)";
+  return info->cannot_read(scene);
+}
+
+}  // namespace
+
 std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
                                                          const MatrixOptions& o,
                                                          const MatrixBackends* built) {
@@ -404,6 +422,10 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
       for (const Method m : o.methods) {
         if (!matrix_measures(o, backend->name(), scene.name, to_string(m))) continue;
         const std::string method = to_string(m);
+        if (!cannot(*backend, m, scene).empty()) {  // only said to be skipped
+          cases.emplace_back(matrix_case_key(backend->name(), method, scene.name), 0.01);
+          continue;
+        }
         double cost = 0.0;
         if (o.conformance)
           cost += conformance_case_cost(backend->name(), method, edge_count(scene), o.conform_width,
@@ -437,8 +459,19 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
           0);
   const auto held = [&](const Backend& backend, Method m, const Scene& scene) {
     return matrix_measures(o, backend.name(), scene.name, to_string(m)) &&
-           (!o.holds || o.holds(matrix_case_key(backend.name(), to_string(m), scene.name)));
+           (!o.holds || o.holds(matrix_case_key(backend.name(), to_string(m), scene.name))) &&
+           cannot(backend, m, scene).empty();
   };
+  for (const auto& backend : backends)
+    for (const Scene& scene : scenes)
+      for (const Method m : o.methods)
+        if (const std::string why = cannot(*backend, m, scene);
+            !why.empty() && matrix_measures(o, backend->name(), scene.name, to_string(m)) &&
+            (!o.holds || o.holds(matrix_case_key(backend->name(), to_string(m), scene.name))))
+          out["skipped"].push_back({{"backend", backend->name()},
+                                    {"scene", scene.name},
+                                    {"method", to_string(m)},
+                                    {"reason", why}});
   for (const std::string& b : o.sampled_backends) {
     if (!out.contains("sampled")) out["sampled"] = json::array();
     out["sampled"].push_back({{"backend", b},
@@ -472,6 +505,8 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
              {"height", o.height}};
         if (const std::optional<DeviceInfo> device = backend->device())
           c["device"] = device_json(*device);
+        if (const ExternalInfo* info = backend->external())
+          c["external"] = conformance::external_json(*info);
         if (o.timing) {
           Frame* keep = nullptr;
           if (!o.images.empty() && m == o.methods.front()) keep = &frames[name];
@@ -484,6 +519,8 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
               suite.run(*backend, scene, params, o.conform_width, o.conform_height));
           c["accuracy"]["size"] =
               std::to_string(o.conform_width) + "x" + std::to_string(o.conform_height);
+        } catch (const CaseSkipped& e) {
+          c["skipped"] = e.what();
         } catch (const std::exception& e) {
           c["error"] = e.what();
         }
@@ -497,6 +534,7 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
     for (const auto& [name, t] : timings(out["benchmarks"])) {
       if (!cases.count(name)) continue;
       json& c = cases[name];
+      if (c.contains("skipped")) continue;
       if (!t.error.empty()) {
         c["error"] = t.error;
         continue;
@@ -506,7 +544,16 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
       c["counters"] = t.counters;
     }
   }
-  for (const std::string& name : order) out["cases"].push_back(cases[name]);
+  for (const std::string& name : order) {
+    const json& c = cases[name];
+    if (c.contains("skipped"))  // its renderer could not render it (CaseSkipped)
+      out["skipped"].push_back({{"backend", c["backend"]},
+                                {"scene", c["scene"]},
+                                {"method", c["method"]},
+                                {"reason", c["skipped"]}});
+    else
+      out["cases"].push_back(c);
+  }
   for (const auto& [name, frame] : frames) {
     if (frame.width == 0) continue;
     const json& c = cases[name];

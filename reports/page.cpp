@@ -72,12 +72,52 @@ Lists registry_lists(const json& results) {
       for (const json& g : results["sweep"].value("analysis", json::array()))
         add_once(l.types, g.value("surface_type", ""));
   }
-  if (l.backends.empty())
-    for (const json& c : cases_of(results)) {
-      add_once(l.backends, c.value("backend", ""));
-      add_once(l.methods, c.value("method", ""));
-    }
+  // Every case's backend and method: an external renderer, registered by the run alone, too.
+  for (const json& c : cases_of(results)) {
+    add_once(l.backends, c.value("backend", ""));
+    add_once(l.methods, c.value("method", ""));
+  }
   return l;
+}
+
+// The renderers we did not write (cases with "external"): per case, how many of its decided
+// pixels end where the oracle's do and cross as they do, its colour's failing share, the failure
+// classes it shows, its verdict and its time (its command's).
+json external_table(const json& cases) {
+  json rows = json::array();
+  for (const json& c : cases) {
+    if (!c.contains("external")) continue;
+    const json& x = c["external"];
+    const json a = c.value("accuracy", json::object());
+    std::set<std::string> unmeasured;
+    const json left_out = a.value("unmeasured", json::array());  // iterated: not a temporary
+    for (const json& u : left_out) unmeasured.insert(u.value("check", ""));
+    const auto share = [&](const char* check, const char* key) {
+      return unmeasured.count(check) || !a.contains(key) ? json(nullptr)
+                                                         : json(1.0 - a[key].get<double>());
+    };
+    json classes = json::object();
+    const json failures = a.value("failures", json::object());  // iterated: not a temporary
+    for (const auto& [name, n] : failures.items())
+      if (n.get<double>() > 0) classes[name] = n;
+    rows.push_back(
+        {{"backend", c.value("backend", "")},
+         {"version", x.value("version", "")},
+         {"look", x.value("look", "")},
+         {"scene", c.value("scene", "")},
+         {"method", c.value("method", "")},
+         {"verdict", a.value("verdict", c.contains("error") ? "error" : "")},
+         {"error", c.value("error", "")},
+         {"hit_right", share("hit_rate", "hit_mismatch")},
+         {"crossings_right", share("crossings_rate", "crossings_mismatch")},
+         {"ambiguous", a.value("ambiguous", 0.0)},
+         {"colour_failing",
+          unmeasured.count("image") || !a.contains("image_fail") ? json(nullptr) : a["image_fail"]},
+         {"classes", classes},
+         {"time_ms", c.value("time_ms", 0.0)},
+         {"time", x.value("time", "")}});
+  }
+  return rows;
 }
 
 std::vector<std::string> verdict_names() {
@@ -236,7 +276,8 @@ json gallery_table(const json& results) {
 // each class's share of all pixels.
 json recommended_table(const json& results) {
   json out = json::array();
-  if (!results.contains("gallery")) return out;
+  // None where no backend is recommended: the gallery is null then.
+  if (!results.contains("gallery") || !results["gallery"].is_object()) return out;
   for (const json& sc : results["gallery"].value("scenes", json::array())) {
     if (sc.contains("error")) {
       out.push_back({{"scene", sc["scene"]}, {"error", sc["error"]}});
@@ -631,6 +672,7 @@ json page_tables(const json& results, const json* previous) {
   page["gallery"] = gallery_table(results);
   page["recommended"] = recommended_table(results);
   page["failures"] = failures_table(cases);
+  page["external"] = external_table(cases);
   page["lanes"] = lanes_table(cases, lists);
   // The last lines of what each unfinished case's worker wrote on its standard error.
   json last_words = json::array();

@@ -780,10 +780,12 @@ json assemble_report(const json& header,
   std::string sweep_from;
   for (const auto& [label, doc] : parts) {
     if (doc->contains("matrix")) {
-      if (!matrix_seen) {
-        matrix_skipped = (*doc)["matrix"].value("skipped", json::array());
-        matrix_sampled = (*doc)["matrix"].value("sampled", json());
-      }
+      if (!matrix_seen) matrix_sampled = (*doc)["matrix"].value("sampled", json());
+      // Each part's skips: whole backends unavailable (the same in every part), and the cases
+      // an external renderer could not render (in their own part).
+      for (const json& skip : (*doc)["matrix"].value("skipped", json::array()))
+        if (std::find(matrix_skipped.begin(), matrix_skipped.end(), skip) == matrix_skipped.end())
+          matrix_skipped.push_back(skip);
       if (matrix_work_counter.is_null())
         matrix_work_counter = (*doc)["matrix"].value("work_counter", json());
       matrix_seen = true;
