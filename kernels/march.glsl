@@ -125,12 +125,22 @@ WallDistance wall_distance(int polygon, vec2 p) {
       }
     }
     if (v.d < params.eps && v.second < params.eps) {
+      // The edge is the nearest segment, the second the next: at a corner both are near; where
+      // two edges lie on one line (a straight angle, as the web app's pillowcase has between
+      // two edges glued to each other), their lines are, but the other segment may be far.
+      real best = real(kFar);
       real next = real(kFar);
       for (int k = 0; k < poly.y; ++k) {
         vec4 s = edges[poly.x + k].segment;
         vec2 a = vec2(s.x, s.y);
         real d2 = segment_distance2(p - a, vec2(s.z, s.w) - a, edges[poly.x + k].line.w);
-        if (k != v.edge) next = min(next, d2);
+        if (d2 < best) {
+          next = best;
+          best = d2;
+          v.edge = k;
+        } else if (d2 < next) {
+          next = d2;
+        }
       }
       v.second = sqrt(next);
     }
@@ -435,8 +445,8 @@ void find_segment(INOUT(Ray) r, INOUT(Segment) seg) {
 // room, of the band or of max_distance).
 bool near_solid(Ray r, Segment seg) {
   return has(kFeatureObjects) && seg.known &&
-         seg.solids < min(min(seg.exit.s, band_exit(params.top, r.o.z, r.d.z)),
-                          params.max_distance - r.t);
+         seg.solids <
+             min(min(seg.exit.s, band_exit(params.top, r.o.z, r.d.z)), params.max_distance - r.t);
 }
 
 // The rest of the room segment: the ray leaves the band, ends, or crosses the exit edge.

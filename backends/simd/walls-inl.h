@@ -291,7 +291,10 @@ class Walls {
     const V eps = Splat(params_.eps);
     const M close = hn::And(lanes, hn::And(w.d < eps, w.second < eps));
     if (Any(close)) {
-      V next = Splat(kFar);
+      // The nearest segment's edge and the next segment's distance (march.glsl's: two collinear
+      // edges' lines are both near where only one segment is).
+      V best = Splat(kFar), next = Splat(kFar);
+      VI nearest = w.edge;
       for (int k = 0; k < most; ++k) {
         if (held && k >= rooms.most_edges) break;
         const Slot at = slot<kOneRoom>(rooms, k);
@@ -302,10 +305,14 @@ class Walls {
         };
         const lane::vec2 ap(px - read(kAx), py - read(kAy)), ab(read(kAbx), read(kAby));
         const V d2 = lane::segment_distance2(ap, ab, read(kInvLength2)).v;
-        const M other = hn::AndNot(Equal(w.edge, k), hn::And(close, at.valid));
-        next = Select(other, hn::Min(next, d2), next);
+        const M in = hn::And(close, at.valid);
+        const M nearer = hn::And(in, d2 < best);
+        next = Select(in, Select(nearer, best, hn::Min(next, d2)), next);
+        best = Select(nearer, d2, best);
+        nearest = Select(nearer, SplatI(k), nearest);
       }
       w.second = Select(close, hn::Sqrt(next), w.second);
+      w.edge = Select(close, nearest, w.edge);
     }
     return w;
   }

@@ -16,6 +16,7 @@
 #include "backends/scalar/scalar.hpp"
 #include "conformance/suite.hpp"
 #include "conformance/tests/test_backends.hpp"
+#include "kernels/compile.hpp"
 #include "scene/load.hpp"
 #include "tests/gallery.hpp"
 #include "tests/test_scenes.hpp"
@@ -206,6 +207,31 @@ TEST_P(Stability, PastAReflexCorner) {
           EXPECT_FALSE(c.failure) << to_string(m) << ": " << c.divergence;
         }
       }
+    }
+  }
+}
+
+// A convex room with two edges on one line (a straight angle at (0, -1)), glued to each other
+// about that point, as the web app's pillowcase is: near the bottom both edges' lines are within
+// eps, but only one segment. A ray meeting the bottom a tenth away from that point crosses
+// the edge it meets (the oracle's path), not a `vertex` end: the kernel once took two near lines
+// for a corner.
+TEST_P(Stability, ThroughEdgesOnOneLine) {
+  const Scene scene = parse_scene(R"({
+    "polygons": [[[0, 1], [-2, 1], [-2, -1], [0, -1], [2, -1], [2, 1]]],
+    "gluings": [[[0, 0], [0, 5]], [[0, 1], [0, 4]], [[0, 2], [0, 3]]],
+    "height": 4, "camera": {"position": [0.5, 0.5, 2]}})",
+                                  "straight_angle.json");
+  ASSERT_EQ(kernel::compile_scene<float>(scene, with(Method::sphere)).params.convex, 1);
+  for (const Method m : kKernelMethods) {
+    const MarchParams p = with(m);
+    for (const double x : {0.1, -0.1, 0.5}) {
+      const Ray ray{0, Vec3(0.0, 0.0, 2.0), glm::normalize(Vec3(x, -1.0, 0.05))};
+      const TraceComparison c = against_oracle(scene, ray, p, 6);
+      EXPECT_FALSE(c.failure) << to_string(m) << " x " << x << ": " << c.divergence;
+      const Trace t = kernel().trace(scene, ray, p, 1);
+      ASSERT_FALSE(t.events.empty());
+      EXPECT_EQ(t.events.front().kind, EventKind::gluing) << to_string(m) << " x " << x;
     }
   }
 }
