@@ -357,21 +357,29 @@ void add_conform(CLI::App& app) {
         [&](const std::string& key) { return run_case(*by_key.at(key)); }, show, journal);
     // A renderer with an expectation file counts against the run by its changes alone, as
     // deqp-runner's do: a case that does not do what its file says (an unexpected pass too).
+    std::map<std::string, std::vector<std::pair<std::string, std::string>>> judged_runs;
+    for (const Case& c : held)
+      if (expectations.count(c.backend->name()))
+        judged_runs[c.backend->name()].emplace_back(c.key, record_verdict(records.at(c.key)));
+    std::map<std::string, nlohmann::json> judged;
     std::vector<std::string> changes;
+    for (const auto& [name, run_of] : judged_runs) {
+      judged[name] = conformance::expectation_outcomes(expectations.at(name), run_of);
+      for (const nlohmann::json& change : judged[name]["changes"]) changes.push_back(change);
+      for (const nlohmann::json& stale : judged[name]["unseen"])
+        std::fprintf(stderr, "conform: %s lists %s, which this run did not have\n",
+                     expectations.at(name).file().c_str(), stale.get<std::string>().c_str());
+    }
     int expected_failures = 0;
     for (const Case& c : held) {
       nlohmann::json record = records.at(c.key);
       record.erase("table");
       const std::string verdict = record_verdict(record);
-      if (const auto e = expectations.find(c.backend->name()); e != expectations.end()) {
-        const std::string outcome = e->second.outcome(c.key, verdict);
-        record["expectation"] = {{"expected", e->second.expected(c.key)}, {"outcome", outcome}};
-        if (conformance::Expectations::change(outcome))
-          changes.push_back(c.key + ": " + outcome + " (expected " + e->second.expected(c.key) +
-                            ")");
-        else
-          expected_failures += verdict != conformance::kVerdictPass && verdict != "skip" &&
-                               verdict != conformance::kVerdictLimit;
+      if (judged.count(c.backend->name())) {
+        record["expectation"] = judged[c.backend->name()]["cases"][c.key];
+        expected_failures += !conformance::Expectations::change(record["expectation"]["outcome"]) &&
+                             verdict != conformance::kVerdictPass && verdict != "skip" &&
+                             verdict != conformance::kVerdictLimit;
       }
       if (verdict == "skip") {
         out["skipped"].push_back({{"backend", c.backend->name()},
@@ -390,15 +398,7 @@ void add_conform(CLI::App& app) {
       }
       out["cases"].push_back(std::move(record));
     }
-    if (!expectations.empty()) {
-      out["changes"] = changes;
-      std::vector<std::string> keys;
-      for (const Case& c : held) keys.push_back(c.key);
-      for (const auto& [name, e] : expectations)
-        for (const std::string& stale : e.unseen(keys))
-          std::fprintf(stderr, "conform: %s lists %s, which this run did not have\n",
-                       e.file().c_str(), stale.c_str());
-    }
+    if (!expectations.empty()) out["changes"] = changes;
     if (!no_images.empty())
       out["unmeasured"] =
           nlohmann::json::array({{{"check", "image.perceptual_failpercent"}, {"why", no_images}}});

@@ -13,6 +13,7 @@
 #include "cli/commands.hpp"
 #include "cli/common.hpp"
 #include "cli/supervised.hpp"
+#include "conformance/expectations.hpp"
 #include "conformance/suite.hpp"
 #include "output/dynamic_library.hpp"
 #include "reports/fingerprint.hpp"
@@ -111,6 +112,44 @@ reports::Shard parse_shard_option(const std::string& text) {
   if (!shard) throw UsageError("--shard: I/N with 1 <= I <= N <= 1000, not " + text);
   return *shard;
 }
+
+namespace {
+
+// The matrix's cases of each external renderer with an expectation file, against it
+// (conformance/expectations.hpp): results["expectations"][RENDERER], and the changes, printed.
+std::vector<std::string> expectation_changes(json& results) {
+  std::map<std::string, std::vector<std::pair<std::string, std::string>>> run;
+  const json& matrix = results.value("matrix", json::object());
+  for (const json& c : matrix.value("cases", json::array()))
+    if (c.contains("external"))
+      run[c["backend"]].emplace_back(
+          c["backend"].get<std::string>() + "/" + c["method"].get<std::string>() + "/" +
+              c["scene"].get<std::string>(),
+          c.contains("accuracy") ? c["accuracy"].value("verdict", "error") : "error");
+  for (const json& skip : matrix.value("skipped", json::array()))
+    if (skip.contains("scene") && run.count(skip["backend"]))
+      run[skip["backend"]].emplace_back(skip["backend"].get<std::string>() + "/" +
+                                            skip["method"].get<std::string>() + "/" +
+                                            skip["scene"].get<std::string>(),
+                                        "skip");
+  std::vector<std::string> changes;
+  for (const auto& [name, cases] : run) {
+    const std::unique_ptr<Backend> backend = make_backend(name, {});
+    const ExternalInfo* info = backend ? backend->external() : nullptr;
+    if (!info || info->expectations.empty()) continue;
+    const json judged = conformance::expectation_outcomes(
+        conformance::Expectations::read(info->expectations), cases);
+    results["expectations"][name] = judged;
+    for (const json& change : judged["changes"]) changes.push_back(change);
+  }
+  if (!changes.empty()) {
+    std::printf("report: %zu changes against the expectation files:\n", changes.size());
+    for (const std::string& change : changes) std::printf("    %s\n", change.c_str());
+  }
+  return changes;
+}
+
+}  // namespace
 
 void add_report(CLI::App& app) {
   auto* cmd = app.add_subcommand(
@@ -556,6 +595,7 @@ void add_report(CLI::App& app) {
       return;
     }
     results["regression"] = regression_section(results, o->baseline);
+    const std::vector<std::string> changes = expectation_changes(results);
     const fs::path file = fs::path(o->out) / "results.json";
     write_json(file, results);
     journal->complete();
@@ -572,6 +612,9 @@ void add_report(CLI::App& app) {
       std::printf("report: open %s\n", (fs::path(o->out) / "index.html").c_str());
     }
     if (!o->baseline.empty()) gate(results, o->baseline, o->out);
+    if (!changes.empty())
+      throw ConformanceFailure(std::to_string(changes.size()) +
+                               " cases changed against their expectation files");
   });
 }
 

@@ -97,4 +97,18 @@ std::vector<std::string> Expectations::unseen(const std::vector<std::string>& ke
   return stale;
 }
 
+nlohmann::json expectation_outcomes(const Expectations& e,
+                                    const std::vector<std::pair<std::string, std::string>>& run) {
+  nlohmann::json cases = nlohmann::json::object(), changes = nlohmann::json::array();
+  std::vector<std::string> keys;
+  for (const auto& [key, verdict] : run) {
+    keys.push_back(key);
+    const std::string outcome = e.outcome(key, verdict);
+    cases[key] = {{"expected", e.expected(key)}, {"outcome", outcome}};
+    if (Expectations::change(outcome))
+      changes.push_back(key + ": " + outcome + " (expected " + e.expected(key) + ")");
+  }
+  return {{"file", e.file()}, {"cases", cases}, {"changes", changes}, {"unseen", e.unseen(keys)}};
+}
+
 }  // namespace flatmarch::conformance

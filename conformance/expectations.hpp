@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace flatmarch::conformance {
 
 class Expectations {
@@ -41,5 +43,11 @@ class Expectations {
   std::map<std::string, std::string> statuses_;
   std::vector<std::pair<std::string, std::regex>> flakes_, skips_;
 };
+
+// A run's cases of one renderer (key and verdict, "skip" for a case it could not render) against
+// its file: {"file", "cases": {KEY: {"expected", "outcome"}}, "changes": ["KEY: OUTCOME (expected
+// VERDICT)"], "unseen": [listed keys the run did not have]}.
+nlohmann::json expectation_outcomes(const Expectations& e,
+                                    const std::vector<std::pair<std::string, std::string>>& run);
 
 }  // namespace flatmarch::conformance

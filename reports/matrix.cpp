@@ -515,10 +515,26 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
         }
         if (!o.conformance) continue;
         try {
-          c["accuracy"] = accuracy_summary(
-              suite.run(*backend, scene, params, o.conform_width, o.conform_height));
+          // Where a renderer we did not write goes wrong, drawn: its error image (as `conform
+          // --error-images`), for the page.
+          const bool where = backend->external() && !o.images.empty();
+          suite.keep_pixel_classes(where);
+          const conformance::CaseResult r =
+              suite.run(*backend, scene, params, o.conform_width, o.conform_height);
+          suite.keep_pixel_classes(false);
+          c["accuracy"] = accuracy_summary(r);
           c["accuracy"]["size"] =
               std::to_string(o.conform_width) + "x" + std::to_string(o.conform_height);
+          if (where) {
+            const std::string diff =
+                backend->name() + "/" + scene.name + "." + to_string(m) + ".diff.png";
+            std::filesystem::create_directories((o.images / diff).parent_path());
+            write_png(conformance::error_image(
+                          r.pixel_classes,
+                          suite.truth_frame(scene, r.params, o.conform_width, o.conform_height)),
+                      o.images / diff);
+            c["diff"] = diff;
+          }
         } catch (const CaseSkipped& e) {
           c["skipped"] = e.what();
         } catch (const std::exception& e) {

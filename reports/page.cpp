@@ -115,6 +115,7 @@ json external_table(const json& cases) {
           unmeasured.count("image") || !a.contains("image_fail") ? json(nullptr) : a["image_fail"]},
          {"classes", classes},
          {"time_ms", c.value("time_ms", 0.0)},
+         {"diff", c.value("diff", "")},
          {"time", x.value("time", "")}});
   }
   return rows;

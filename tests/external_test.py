@@ -137,6 +137,31 @@ check(r.returncode == 1 and results["changes"] == [
 check(sum(1 for s in results["skipped"] if s["backend"] == "better") == 1,
       "the expectation file's skip line skips the sphere cases")
 
+# The report: the renderers beside the scalar backend, in results.json and on the page, with
+# where each goes wrong drawn, and the expectation file's change.
+r = subprocess.run([FLATMARCH, "report", "--scene", "torus", "--backend", "scalar", "--method",
+                    "analytic", "--external", "mine=" + EXAMPLE, "--external", manifests["better"],
+                    "--no-sweep", "--no-scaling", "--size", "32x18", "--conform-size", "48x27",
+                    "--repetitions", "2", "--min-time", "0.001", "-o", "report", "-q"],
+                   cwd=OUT, capture_output=True, text=True, timeout=600)
+print(r.stdout[-2000:], r.stderr[-2000:])
+check(r.returncode == 1, f"report exits 1 on the expectation file's change (got {r.returncode})")
+report = json.load(open(os.path.join(OUT, "report", "results.json")))
+rcases = {(c["backend"], c["method"]): c for c in report["matrix"]["cases"]}
+check(rcases[("mine", "analytic")]["accuracy"]["verdict"] ==
+      rcases[("scalar", "analytic")]["accuracy"]["verdict"] == "pass",
+      "the report judges the example adapter as the backend it wraps")
+check("the command's" in rcases[("mine", "analytic")]["external"]["time"],
+      "the report says the renderer's time is its command's")
+diff = os.path.join(OUT, "report", "images", rcases[("mine", "analytic")].get("diff", "none"))
+check(os.path.exists(diff), f"where it goes wrong is drawn ({diff})")
+check(report.get("expectations", {}).get("better", {}).get("changes") ==
+      ["better/analytic/torus: unexpected pass (expected fail)"],
+      f"the report's results hold the change ({report.get('expectations')})")
+page = open(os.path.join(OUT, "report", "index.html")).read()
+check("Renderers we did not write" in page and "unexpected pass" in page,
+      "the page lists the renderers and the change")
+
 r = conform("--external", os.path.join(DATA, "bad_manifest.json"))
 check(r.returncode == 2 and "/channels/1" in r.stderr and "normals" in r.stderr,
       f"a bad manifest is refused naming its key: exit {r.returncode}, {r.stderr.strip()}")
