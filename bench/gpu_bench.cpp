@@ -29,6 +29,7 @@
 #include "backends/vulkan/vulkan.hpp"
 #include "bench/gallery.hpp"
 #include "bench/peer_app.hpp"
+#include "interop/peer_import.hpp"
 
 namespace flatmarch::bench {
 
@@ -149,7 +150,7 @@ int main(int argc, char** argv) {
         MarchParams params;
         params.method = method;
         bench::add(("peer/" + backend->name() + "/" + view.name + "/" + to_string(method)).c_str(),
-                   bench::frame, backend, peers.back().get(), bench::peer_camera(*peers.back()),
+                   bench::frame, backend, peers.back().get(), benchmark_view(peers.back()->camera),
                    params, peer_size, std::string(view.name))
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();

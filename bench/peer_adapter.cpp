@@ -87,14 +87,6 @@ Options parse_options(int argc, char** argv) {
   return o;
 }
 
-std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error("cannot read " + file.string());
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // A fresh folder under the system's temporary one, removed with its files at the end.
 class TemporaryFolder {
  public:

@@ -20,7 +20,9 @@ namespace {
 // is gl_Vertex in the compatibility profile.
 const char* const kVertexShader = "#version 120\nvoid main() { gl_Position = gl_Vertex; }\n";
 
-std::string read(const std::filesystem::path& file) {
+}  // namespace
+
+std::string read_text(const std::filesystem::path& file) {
   std::ifstream in(file);
   if (!in) throw std::runtime_error("cannot read " + file.string());
   std::stringstream text;
@@ -28,21 +30,11 @@ std::string read(const std::filesystem::path& file) {
   return text.str();
 }
 
-}  // namespace
-
 Scene peer_scene(const PeerView& view) {
   const std::string file = std::string(view.id) + ".json";
   const PeerImport imported = import_peer_file(std::filesystem::path(FLATMARCH_SOURCE_DIR) /
                                                "tests" / "data" / "peer-geometries" / file);
   return scene_from_json(imported.scene, file);
-}
-
-Camera peer_camera(const Scene& scene) {
-  Camera camera = scene.camera;
-  camera.position += Vec3(0.5, 0.5, 0.0);
-  camera.yaw_deg = glm::degrees(std::atan2(0.3, 1.0));
-  camera.pitch_deg = 0.0;
-  return camera;
 }
 
 AppView app_view(glm::vec3 start) {
@@ -52,7 +44,7 @@ AppView app_view(glm::vec3 start) {
 
 std::map<std::string, glm::vec3> app_starts(const std::filesystem::path& folder) {
   std::map<std::string, glm::vec3> starts;
-  const nlohmann::json meta = nlohmann::json::parse(read(folder / "meta.json"));
+  const nlohmann::json meta = nlohmann::json::parse(read_text(folder / "meta.json"));
   for (const auto& [id, m] : meta.items()) {
     const auto p = m.value("initialPosition", std::vector<float>{0.0f, 1.0f, 0.0f});
     starts[id] = glm::vec3(p.at(0), p.at(1), p.at(2));
@@ -61,7 +53,7 @@ std::map<std::string, glm::vec3> app_starts(const std::filesystem::path& folder)
 }
 
 std::string app_shader(const std::filesystem::path& folder, const std::string& id) {
-  return read(folder / (id + ".frag"));
+  return read_text(folder / (id + ".frag"));
 }
 
 AppTriangle::AppTriangle(const gl::Api& gl) : gl_(gl) {

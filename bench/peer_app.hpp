@@ -32,12 +32,6 @@ inline constexpr PeerView kPeerViews[] = {{"L_shape", "l_shape"},
 // A view's geometry imported as our scene (interop/peer_import.hpp).
 Scene peer_scene(const PeerView& view);
 
-// The app's view: from its start point + (0.5, 0, 0.5), looking along normalize(1, 0, 0.3) in its
-// coordinates (y up). The importer maps its (x, y, z) to our (x, z, y + wall height) and its
-// field of view to ours, so the view is the scene's camera moved by (0.5, 0.5, 0) and turned to
-// yaw atan2(0.3, 1), level. (Our image is the app's mirrored left to right: the same rays.)
-Camera peer_camera(const Scene& scene);
-
 // The same view as the app's shader takes it: its uniforms rayMarchCamPos, rayMarchCamFront and
 // rayMarchCamUp, from the app's start point.
 struct AppView {
@@ -46,6 +40,8 @@ struct AppView {
 AppView app_view(glm::vec3 start);
 // The app's start points (initialPosition, default (0, 1, 0)) by id, from FOLDER/meta.json.
 std::map<std::string, glm::vec3> app_starts(const std::filesystem::path& folder);
+// A file's text; throws std::runtime_error "cannot read FILE".
+std::string read_text(const std::filesystem::path& file);
 // FOLDER/ID.frag, the app's shader of a geometry, as it comes (GLSL without a version line).
 std::string app_shader(const std::filesystem::path& folder, const std::string& id);
 

@@ -26,6 +26,7 @@
 #include "backends/webgl/chromium.hpp"
 #include "bench/gallery.hpp"
 #include "bench/peer_app.hpp"
+#include "interop/peer_import.hpp"
 #include "scene/inspect.hpp"
 #include "web/page.hpp"
 
@@ -201,7 +202,7 @@ int main(int argc, char** argv) {
     for (const Method method : kKernelMethods) {
       const nlohmann::json request = {
           {"method", to_string(method)},
-          {"camera", nlohmann::json(camera_json(bench::peer_camera(scene)))},
+          {"camera", nlohmann::json(camera_json(benchmark_view(scene.camera)))},
           {"w", size.width},
           {"h", size.height}};
       bench::add(

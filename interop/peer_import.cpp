@@ -907,14 +907,22 @@ bool is_peer_geometry(const nlohmann::json& doc) {
          !doc.contains("polygons");
 }
 
+Camera benchmark_view(Camera start) {
+  start.position += Vec3(0.5, 0.5, 0.0);
+  start.yaw_deg = std::atan2(0.3, 1.0) * 180.0 / std::acos(-1.0);
+  start.pitch_deg = 0.0;
+  return start;
+}
+
 void use_benchmark_view(nlohmann::ordered_json& scene) {
-  nlohmann::ordered_json& camera = scene["camera"];
-  auto position = camera["position"].get<std::vector<double>>();
-  position.at(0) += 0.5;
-  position.at(1) += 0.5;
-  camera["position"] = position;
-  camera["yaw_deg"] = std::atan2(0.3, 1.0) * 180.0 / std::acos(-1.0);
-  camera["pitch_deg"] = 0.0;
+  nlohmann::ordered_json& json = scene["camera"];
+  const auto position = json["position"].get<std::vector<double>>();
+  Camera camera;
+  camera.position = Vec3(position.at(0), position.at(1), position.at(2));
+  camera = benchmark_view(camera);
+  json["position"] = {camera.position.x, camera.position.y, camera.position.z};
+  json["yaw_deg"] = camera.yaw_deg;
+  json["pitch_deg"] = camera.pitch_deg;
 }
 
 nlohmann::ordered_json findings_json(const std::vector<PeerFinding>& findings) {

@@ -15,6 +15,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/scene.hpp"
+
 namespace flatmarch {
 
 enum class Severity {
@@ -52,7 +54,10 @@ bool is_peer_geometry(const nlohmann::json& doc);
 // Turns an imported scene's camera to the view the benchmarks take of the app
 // (../shared/peer-shaders.md): from the app's start point + (0.5, 0, 0.5), looking along
 // normalize(1, 0, 0.3), level, which is here the start moved by (0.5, 0.5, 0) and turned to yaw
-// atan2(0.3, 1). The field of view stays the app's.
+// atan2(0.3, 1). The field of view stays the app's. (Our image is the app's mirrored left to
+// right: the same rays.)
+Camera benchmark_view(Camera start);
+// The same, on an imported scene's JSON.
 void use_benchmark_view(nlohmann::ordered_json& scene);
 
 nlohmann::ordered_json findings_json(const std::vector<PeerFinding>& findings);
