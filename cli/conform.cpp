@@ -218,34 +218,20 @@ void add_conform(CLI::App& app) {
     }
     // A renderer we did not write runs the cases it can: its methods, the scenes it reads, and
     // not those its expectation file skips; the others are skipped, saying why.
-    std::map<std::string, conformance::Expectations> expectations;
-    for (const auto& backend : backends)
-      if (const ExternalInfo* info = backend->external(); info && !info->expectations.empty()) {
-        try {
-          expectations[backend->name()] = conformance::Expectations::read(info->expectations);
-        } catch (const std::invalid_argument& e) {
-          throw UsageError(std::string("--external ") + backend->name() + ": " + e.what());
-        }
+    const conformance::ExternalSkips skips = [&] {
+      try {
+        return conformance::ExternalSkips(backends);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
       }
-    const auto skip_why = [&](const Backend& backend, const Scene& scene, Method m) {
-      const ExternalInfo* info = backend.external();
-      if (!info) return std::string();
-      const std::vector<Method> own = backend.methods();
-      if (std::find(own.begin(), own.end(), m) == own.end())
-        return "it renders no " + std::string(to_string(m)) + " cases (its manifest's methods)";
-      if (std::string why = info->cannot_read(scene); !why.empty()) return why;
-      const auto e = expectations.find(backend.name());
-      if (e != expectations.end() &&
-          e->second.skipped(backend.name() + "/" + to_string(m) + "/" + scene.name))
-        return "its expectation file skips it (" + e->second.file() + ")";
-      return std::string();
-    };
+    }();
+    const std::map<std::string, conformance::Expectations>& expectations = skips.files();
     std::vector<std::pair<std::string, double>> run;
     for (const auto& backend : backends)
       for (const Scene& scene : scenes)
         for (const Method m : methods) {
           const std::string key = backend->name() + "/" + to_string(m) + "/" + scene.name;
-          if (const std::string why = skip_why(*backend, scene, m); !why.empty()) {
+          if (const std::string why = skips.why(*backend, m, scene); !why.empty()) {
             out["skipped"].push_back({{"backend", backend->name()},
                                       {"scene", scene.name},
                                       {"method", to_string(m)},
@@ -274,7 +260,7 @@ void add_conform(CLI::App& app) {
       for (const auto& backend : backends)
         for (const Scene& scene : scenes)
           for (const Method m : methods) {
-            if (!skip_why(*backend, scene, m).empty()) continue;
+            if (!skips.why(*backend, m, scene).empty()) continue;
             const auto& [key, cost] = run[k++];
             if (plan.holds(key)) held.push_back({key, backend.get(), &scene, m, cost});
           }
@@ -385,7 +371,8 @@ void add_conform(CLI::App& app) {
         out["skipped"].push_back({{"backend", c.backend->name()},
                                   {"scene", c.scene->name},
                                   {"method", to_string(c.method)},
-                                  {"reason", record["skipped"]}});
+                                  {"reason", record["skipped"]},
+                                  {"by_renderer", true}});
         if (record.contains("expectation"))
           out["skipped"].back()["expectation"] = record["expectation"];
         continue;

@@ -575,4 +575,29 @@ std::optional<Channel> look_colours(const std::string& look, const Scene& scene,
   return rgb;
 }
 
+ExternalSkips::ExternalSkips(const std::vector<std::unique_ptr<Backend>>& backends) {
+  for (const auto& backend : backends)
+    if (const ExternalInfo* info = backend->external(); info && !info->expectations.empty()) {
+      try {
+        files_[backend->name()] = Expectations::read(info->expectations);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("--external " + backend->name() + ": " + e.what());
+      }
+    }
+}
+
+std::string ExternalSkips::why(const Backend& backend, Method m, const Scene& scene) const {
+  const ExternalInfo* info = backend.external();
+  if (!info) return {};
+  const std::vector<Method> methods = backend.methods();
+  if (std::find(methods.begin(), methods.end(), m) == methods.end())
+    return "it renders no " + std::string(to_string(m)) + " cases (its manifest's methods)";
+  if (std::string why = info->cannot_read(scene); !why.empty()) return why;
+  const auto file = files_.find(backend.name());
+  if (file != files_.end() &&
+      file->second.skipped(backend.name() + "/" + to_string(m) + "/" + scene.name))
+    return "its expectation file skips it (" + file->second.file() + ")";
+  return {};
+}
+
 }  // namespace flatmarch::conformance

@@ -6,6 +6,8 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backends/backend.hpp"
+#include "conformance/expectations.hpp"
 
 namespace flatmarch::conformance {
 
@@ -58,5 +61,22 @@ nlohmann::json external_request(const Scene& scene, const Camera& camera, int wi
 std::optional<Channel> look_colours(const std::string& look, const Scene& scene,
                                     const Camera& camera, int width, int height,
                                     const MarchParams& params);
+
+// Why a renderer we did not write does not render a case: a method its manifest lacks, a scene it
+// cannot read, a `skip` line of its expectation file; empty for a case it renders and for every
+// case of our backends. `conform` and `report` skip such a case, saying why.
+class ExternalSkips {
+ public:
+  ExternalSkips() = default;
+  // Reads each external renderer's expectation file once; throws std::invalid_argument
+  // "--external NAME: FILE:LINE: what is wrong" for one that cannot be used.
+  explicit ExternalSkips(const std::vector<std::unique_ptr<Backend>>& backends);
+  std::string why(const Backend& backend, Method m, const Scene& scene) const;
+  // The expectation files read, by renderer.
+  const std::map<std::string, Expectations>& files() const { return files_; }
+
+ private:
+  std::map<std::string, Expectations> files_;
+};
 
 }  // namespace flatmarch::conformance

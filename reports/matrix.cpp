@@ -384,6 +384,7 @@ MatrixBackends matrix_backends(const MatrixOptions& o) {
     }
     out.available.push_back(std::move(b));
   }
+  out.external = conformance::ExternalSkips(out.available);
   return out;
 }
 
@@ -395,34 +396,19 @@ bool matrix_measures(const MatrixOptions& o, const std::string& backend, const s
   return !has(o.sampled_backends, backend) || has(o.sample_cases, scene + "/" + method);
 }
 
-namespace {
-
-// Why a renderer we did not write (Backend::external) cannot render a case: a method it has not,
-// a scene it cannot read; empty for one it can, and for every case of ours. Such a case is
-// skipped, saying why.
-std::string cannot(const Backend& backend, Method m, const Scene& scene) {
-  const ExternalInfo* info = backend.external();
-  if (!info) return {};
-  const std::vector<Method> methods = backend.methods();
-  if (std::find(methods.begin(), methods.end(), m) == methods.end())
-    return "it renders no " + std::string(to_string(m)) + " cases (its manifest's methods)";
-  return info->cannot_read(scene);
-}
-
-}  // namespace
-
 std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene>& scenes,
                                                          const MatrixOptions& o,
                                                          const MatrixBackends* built) {
   std::optional<MatrixBackends> own;
   if (!built) own = matrix_backends(o);
   std::vector<std::pair<std::string, double>> cases;
-  for (const auto& backend : (built ? *built : *own).available)
+  const MatrixBackends& made = built ? *built : *own;
+  for (const auto& backend : made.available)
     for (const Scene& scene : scenes)
       for (const Method m : o.methods) {
         if (!matrix_measures(o, backend->name(), scene.name, to_string(m))) continue;
         const std::string method = to_string(m);
-        if (!cannot(*backend, m, scene).empty()) {  // only said to be skipped
+        if (!made.external.why(*backend, m, scene).empty()) {  // only said to be skipped
           cases.emplace_back(matrix_case_key(backend->name(), method, scene.name), 0.01);
           continue;
         }
@@ -460,12 +446,12 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
   const auto held = [&](const Backend& backend, Method m, const Scene& scene) {
     return matrix_measures(o, backend.name(), scene.name, to_string(m)) &&
            (!o.holds || o.holds(matrix_case_key(backend.name(), to_string(m), scene.name))) &&
-           cannot(backend, m, scene).empty();
+           made.external.why(backend, m, scene).empty();
   };
   for (const auto& backend : backends)
     for (const Scene& scene : scenes)
       for (const Method m : o.methods)
-        if (const std::string why = cannot(*backend, m, scene);
+        if (const std::string why = made.external.why(*backend, m, scene);
             !why.empty() && matrix_measures(o, backend->name(), scene.name, to_string(m)) &&
             (!o.holds || o.holds(matrix_case_key(backend->name(), to_string(m), scene.name))))
           out["skipped"].push_back({{"backend", backend->name()},
@@ -566,7 +552,8 @@ json run_matrix(const std::vector<Scene>& scenes, const MatrixOptions& o, confor
       out["skipped"].push_back({{"backend", c["backend"]},
                                 {"scene", c["scene"]},
                                 {"method", c["method"]},
-                                {"reason", c["skipped"]}});
+                                {"reason", c["skipped"]},
+                                {"by_renderer", true}});
     else
       out["cases"].push_back(c);
   }

@@ -14,6 +14,7 @@
 #include <benchmark/benchmark.h>
 
 #include "backends/backend.hpp"
+#include "conformance/external.hpp"
 #include "conformance/suite.hpp"
 
 namespace flatmarch::reports {
@@ -85,10 +86,14 @@ std::string device_label(const DeviceInfo& device);
 
 // The matrix's backends that can run here, made once (a worker of a supervised report runs case
 // after case on them), and "skipped": the others, each {"backend", "reason"}.
+// `external` says which cases a renderer we did not write does not render (its methods, the
+// scenes it reads, its expectation file's skip lines); those are skipped, saying why.
 struct MatrixBackends {
   std::vector<std::unique_ptr<Backend>> available;
   nlohmann::json skipped = nlohmann::json::array();
+  conformance::ExternalSkips external;
 };
+// Throws std::invalid_argument for an external renderer's expectation file that cannot be used.
 MatrixBackends matrix_backends(const MatrixOptions& options);
 
 // The matrix's cases (backends available here x scenes x methods, in run_matrix's order) by key,

@@ -139,7 +139,7 @@ check(sum(1 for s in results["skipped"] if s["backend"] == "better") == 1,
 # The report: the renderers beside the scalar backend, in results.json and on the page, with
 # where each goes wrong drawn, and the expectation file's change.
 r = subprocess.run([FLATMARCH, "report", "--scene", "torus", "--backend", "scalar", "--method",
-                    "analytic", "--external", "mine=" + EXAMPLE, "--external", manifests["better"],
+                    "analytic", "--method", "sphere", "--external", "mine=" + EXAMPLE, "--external", manifests["better"],
                     "--no-sweep", "--no-scaling", "--size", "32x18", "--conform-size", "48x27",
                     "--repetitions", "2", "--min-time", "0.001", "-o", "report", "-q"],
                    cwd=OUT, capture_output=True, text=True, timeout=600)
@@ -157,6 +157,10 @@ check(os.path.exists(diff), f"where it goes wrong is drawn ({diff})")
 check(report.get("expectations", {}).get("better", {}).get("changes") ==
       ["better/analytic/torus: unexpected pass (expected fail)"],
       f"the report's results hold the change ({report.get('expectations')})")
+check([s["method"] for s in report["matrix"]["skipped"] if s.get("backend") == "better"] ==
+      ["sphere"] and not any(c["backend"] == "better" and c["method"] == "sphere"
+                             for c in report["matrix"]["cases"]),
+      f"the report skips what the expectation file skips ({report['matrix']['skipped']})")
 page = open(os.path.join(OUT, "report", "index.html")).read()
 check("Renderers we did not write" in page and "unexpected pass" in page,
       "the page lists the renderers and the change")
