@@ -197,7 +197,7 @@ TEST(Thresholds, LayersApplyInOrderAndExceptionsSayWhy) {
 }
 
 TEST(Thresholds, ABadFileNamesTheKey) {
-  const auto path = std::filesystem::temp_directory_path() / "flatmarch_thresholds_test.json";
+  const auto path = std::filesystem::path(test::make_temp_dir()) / "thresholds.json";
   const auto error = [&](const std::string& text) {
     std::ofstream(path) << text;
     try {

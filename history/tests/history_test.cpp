@@ -15,6 +15,7 @@
 #include "history/changes.hpp"
 #include "history/database.hpp"
 #include "history/runs.hpp"
+#include "tests/process.hpp"
 
 namespace flatmarch::history {
 namespace {
@@ -22,10 +23,9 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
+// A file of the test's own folder, removed at exit (test::make_temp_dir).
 fs::path scratch(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("flatmarch_history_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  static const fs::path dir = test::make_temp_dir();
   const fs::path p = dir / name;
   fs::remove(p);
   return p;
