@@ -25,6 +25,11 @@ void add_supervision_options(CLI::App& cmd, SupervisionOptions& o, const std::st
   cmd.add_option("--deadline-floor", o.deadline_floor, "... and at least this many seconds")
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
+  cmd.add_option("--worker-start", o.worker_start,
+                 "Seconds a fresh worker has for its start (loading the scenes, starting its "
+                 "backends: a browser, GPU contexts), on top of its first case's deadline")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
   cmd.add_option("--worker-memory", o.worker_memory_gib,
                  "A worker's address-space limit in GiB (default: the machine's memory, or its "
                  "cgroup's where lower, but at least 8, since drivers reserve more address space "
@@ -77,6 +82,7 @@ namespace {
 // How a run's workers are started: this program again, --worker, limited to --worker-memory.
 reports::WorkerOptions worker_options(const SupervisionOptions& o) {
   reports::WorkerOptions workers;
+  workers.start_seconds = o.worker_start;
   workers.argv = worker_command();
   workers.memory_bytes = o.worker_memory_gib > 0.0
                              ? o.worker_memory_gib * 1024.0 * 1024.0 * 1024.0

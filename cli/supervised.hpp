@@ -21,11 +21,13 @@ namespace flatmarch::cli {
 struct SupervisionOptions {
   std::string isolate = "worker";
   double deadline_scale = 10.0, deadline_floor = 30.0, worker_memory_gib = 0.0;
+  double worker_start = 30.0;  // seconds a fresh worker has to start, beside its first deadline
   bool resume = false;
   bool worker = false;  // this process is a worker of a supervised run
 };
 
-// Adds --isolate, --deadline-scale, --deadline-floor, --worker-memory, --resume and --worker
+// Adds --isolate, --deadline-scale, --deadline-floor, --worker-start, --worker-memory, --resume
+// and --worker
 // to `cmd`; `journal` says where the journal lies ("beside --json, JSON.journal").
 void add_supervision_options(CLI::App& cmd, SupervisionOptions& o, const std::string& journal);
 
