@@ -136,10 +136,11 @@ check(r.returncode == 1 and results["changes"] == [
 check(sum(1 for s in results["skipped"] if s["backend"] == "better") == 1,
       "the expectation file's skip line skips the sphere cases")
 
-# The report: the renderers beside the scalar backend, in results.json and on the page, with
-# where each goes wrong drawn, and the expectation file's change.
+# The report: the example adapter (as "better", with its expectation file) beside the scalar
+# backend, in results.json and on the page, with where it goes wrong drawn, the expectation
+# file's change, and the case its skip line skips.
 r = subprocess.run([FLATMARCH, "report", "--scene", "torus", "--backend", "scalar", "--method",
-                    "analytic", "--method", "sphere", "--external", "mine=" + EXAMPLE, "--external", manifests["better"],
+                    "analytic", "--method", "sphere", "--external", manifests["better"],
                     "--no-sweep", "--no-scaling", "--size", "32x18", "--conform-size", "48x27",
                     "--repetitions", "2", "--min-time", "0.001", "-o", "report", "-q"],
                    cwd=OUT, capture_output=True, text=True, timeout=600)
@@ -147,12 +148,12 @@ print(r.stdout[-2000:], r.stderr[-2000:])
 check(r.returncode == 1, f"report exits 1 on the expectation file's change (got {r.returncode})")
 report = json.load(open(os.path.join(OUT, "report", "results.json")))
 rcases = {(c["backend"], c["method"]): c for c in report["matrix"]["cases"]}
-check(rcases[("mine", "analytic")]["accuracy"]["verdict"] ==
+check(rcases[("better", "analytic")]["accuracy"]["verdict"] ==
       rcases[("scalar", "analytic")]["accuracy"]["verdict"] == "pass",
       "the report judges the example adapter as the backend it wraps")
-check("the command's" in rcases[("mine", "analytic")]["external"]["time"],
+check("the command's" in rcases[("better", "analytic")]["external"]["time"],
       "the report says the renderer's time is its command's")
-diff = os.path.join(OUT, "report", "images", rcases[("mine", "analytic")].get("diff", "none"))
+diff = os.path.join(OUT, "report", "images", rcases[("better", "analytic")].get("diff", "none"))
 check(os.path.exists(diff), f"where it goes wrong is drawn ({diff})")
 check(report.get("expectations", {}).get("better", {}).get("changes") ==
       ["better/analytic/torus: unexpected pass (expected fail)"],
