@@ -307,6 +307,18 @@ std::string matrix_case_key(const std::string& backend, const std::string& metho
   return "matrix/" + backend + "/" + method + "/" + scene;
 }
 
+std::optional<CaseKey> parse_case_key(const std::string& key) {
+  const size_t b = key.find('/'), m = b == std::string::npos ? b : key.find('/', b + 1),
+               n = m == std::string::npos ? m : key.find('/', m + 1);
+  if (n == std::string::npos) return std::nullopt;
+  CaseKey k{key.substr(0, b), key.substr(b + 1, m - b - 1), key.substr(m + 1, n - m - 1),
+            key.substr(n + 1)};
+  if ((k.stage != "matrix" && k.stage != "compile") || k.backend.empty() || k.method.empty() ||
+      k.scene.empty())
+    return std::nullopt;
+  return k;
+}
+
 std::vector<std::pair<std::string, double>> compile_cases(
     const std::vector<std::pair<std::string, double>>& cases, const std::vector<Scene>& scenes,
     const std::vector<std::string>& backends) {
@@ -314,20 +326,17 @@ std::vector<std::pair<std::string, double>> compile_cases(
   for (const Scene& s : scenes) by_name[s.name] = &s;
   std::vector<std::pair<std::string, double>> out;
   for (const auto& c : cases) {
-    // "matrix/BACKEND/METHOD/SCENE"
-    if (c.first.rfind("matrix/", 0) != 0) continue;
-    const size_t b = c.first.find('/', 7);
-    if (b == std::string::npos) continue;
-    const std::string backend = c.first.substr(7, b - 7);
-    if (std::find(backends.begin(), backends.end(), backend) == backends.end()) continue;
-    const size_t m = c.first.find('/', b + 1);
-    if (m == std::string::npos) continue;
-    const auto scene = by_name.find(c.first.substr(m + 1));
+    const std::optional<CaseKey> k = parse_case_key(c.first);
+    if (!k || k->stage != "matrix" ||
+        std::find(backends.begin(), backends.end(), k->backend) == backends.end())
+      continue;
+    const auto scene = by_name.find(k->scene);
     if (scene == by_name.end()) continue;
     // A case's three programs on llvmpipe and lavapipe (a 2-core Zen 5, two cases at once):
     // 0.5-0.6 s in a scene of one room, about 1.8 s in two, 3.7-6.6 s in the cube's six.
     const double rooms = static_cast<double>(scene->second->polygons.size());
-    out.emplace_back("compile/" + c.first.substr(7), 0.5 + (rooms - 1.0));
+    out.emplace_back("compile/" + k->backend + "/" + k->method + "/" + k->scene,
+                     0.5 + (rooms - 1.0));
   }
   return out;
 }
@@ -335,21 +344,16 @@ std::vector<std::pair<std::string, double>> compile_cases(
 json run_compile_case(const std::string& key, const std::vector<Scene>& scenes,
                       const MatrixOptions& o,
                       const std::vector<std::unique_ptr<Backend>>& backends) {
-  // "compile/BACKEND/METHOD/SCENE"
-  const size_t b = key.find('/'), m = b == std::string::npos ? b : key.find('/', b + 1),
-               n = m == std::string::npos ? m : key.find('/', m + 1);
-  if (key.rfind("compile/", 0) != 0 || n == std::string::npos)
-    throw std::invalid_argument("not a compile case: " + key);
-  const std::string backend = key.substr(b + 1, m - b - 1), method = key.substr(m + 1, n - m - 1),
-                    scene_name = key.substr(n + 1);
+  const std::optional<CaseKey> k = parse_case_key(key);
+  if (!k || k->stage != "compile") throw std::invalid_argument("not a compile case: " + key);
   const auto scene = std::find_if(scenes.begin(), scenes.end(),
-                                  [&](const Scene& s) { return s.name == scene_name; });
-  const std::optional<Method> parsed = parse_method(method);
+                                  [&](const Scene& s) { return s.name == k->scene; });
+  const std::optional<Method> parsed = parse_method(k->method);
   if (scene == scenes.end() || !parsed)
     throw std::invalid_argument("no such scene or method here: " + key);
   const auto it =
       std::find_if(backends.begin(), backends.end(),
-                   [&](const std::unique_ptr<Backend>& x) { return x->name() == backend; });
+                   [&](const std::unique_ptr<Backend>& x) { return x->name() == k->backend; });
   if (it == backends.end()) throw std::invalid_argument("no such backend here: " + key);
   const Backend& on = **it;
   MarchParams params = o.params;

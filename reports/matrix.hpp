@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,12 @@ bool matrix_measures(const MatrixOptions& o, const std::string& backend, const s
 // A matrix case's key in a sharded run's case list: "matrix/BACKEND/METHOD/SCENE".
 std::string matrix_case_key(const std::string& backend, const std::string& method,
                             const std::string& scene);
+// A matrix or compile case's key taken apart: "STAGE/BACKEND/METHOD/SCENE" (STAGE "matrix" or
+// "compile"); std::nullopt for a key of another shape or stage.
+struct CaseKey {
+  std::string stage, backend, method, scene;
+};
+std::optional<CaseKey> parse_case_key(const std::string& key);
 
 // The kernels of the matrix's GPU cases, compiled ahead (a report's "compile" stage). A GPU
 // backend's case compiles three programs (its whole frame, its frame of the colour alone, the

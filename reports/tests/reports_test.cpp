@@ -79,6 +79,24 @@ TEST(CompileCases, OneForEachMatrixCaseOfTheCompilingBackends) {
     EXPECT_THROW(run_compile_case(bad, scenes, o, backends), std::invalid_argument) << bad;
 }
 
+// A matrix or compile case's key taken apart as matrix_case_key puts it together; keys of other
+// shapes and stages refused.
+TEST(CaseKeys, TakenApartAsTheyAreMade) {
+  const std::optional<CaseKey> k = parse_case_key(matrix_case_key("opengl", "sphere", "l_shape"));
+  ASSERT_TRUE(k);
+  EXPECT_EQ(k->stage, "matrix");
+  EXPECT_EQ(k->backend, "opengl");
+  EXPECT_EQ(k->method, "sphere");
+  EXPECT_EQ(k->scene, "l_shape");
+  const std::optional<CaseKey> c = parse_case_key("compile/vulkan/analytic/cube");
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->stage, "compile");
+  EXPECT_EQ(c->scene, "cube");
+  for (const char* bad : {"sweep/translation/sphere/x", "matrix/scalar/analytic", "matrix//a/b",
+                          "compile/scalar/analytic/", "matrix", ""})
+    EXPECT_FALSE(parse_case_key(bad)) << bad;
+}
+
 TEST(GeneratedSurfaces, RegularPolygonHasTheGenusOfItsEdgeCount) {
   // A regular 2n-gon's corners sum to 2pi(n - 1): one cone point for even n (genus n/2), two
   // for odd n (genus (n-1)/2).
