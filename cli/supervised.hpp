@@ -27,8 +27,7 @@ struct SupervisionOptions {
 };
 
 // Adds --isolate, --deadline-scale, --deadline-floor, --worker-start, --worker-memory, --resume
-// and --worker
-// to `cmd`; `journal` says where the journal lies ("beside --json, JSON.journal").
+// and --worker to `cmd`; `journal` says where the journal lies ("beside --json, JSON.journal").
 void add_supervision_options(CLI::App& cmd, SupervisionOptions& o, const std::string& journal);
 
 // A case of a run: its key (what a worker is handed) and its expected seconds (the cost model's).
