@@ -230,7 +230,7 @@ void add_conform(CLI::App& app) {
     for (const auto& backend : backends)
       for (const Scene& scene : scenes)
         for (const Method m : methods) {
-          const std::string key = backend->name() + "/" + to_string(m) + "/" + scene.name;
+          const std::string key = conformance::case_key(backend->name(), to_string(m), scene.name);
           if (const std::string why = skips.why(*backend, m, scene); !why.empty()) {
             out["skipped"].push_back({{"backend", backend->name()},
                                       {"scene", scene.name},

@@ -125,15 +125,12 @@ std::vector<std::string> expectation_changes(json& results) {
   for (const json& c : matrix.value("cases", json::array()))
     if (c.contains("external"))
       run[c["backend"]].emplace_back(
-          c["backend"].get<std::string>() + "/" + c["method"].get<std::string>() + "/" +
-              c["scene"].get<std::string>(),
+          conformance::case_key(c["backend"], c["method"], c["scene"]),
           c.contains("accuracy") ? c["accuracy"].value("verdict", "error") : "error");
   for (const json& skip : matrix.value("skipped", json::array()))
     if (skip.value("by_renderer", false))
-      run[skip["backend"]].emplace_back(skip["backend"].get<std::string>() + "/" +
-                                            skip["method"].get<std::string>() + "/" +
-                                            skip["scene"].get<std::string>(),
-                                        "skip");
+      run[skip["backend"]].emplace_back(
+          conformance::case_key(skip["backend"], skip["method"], skip["scene"]), "skip");
   std::vector<std::string> changes;
   for (const auto& [name, cases] : run) {
     const std::unique_ptr<Backend> backend = make_backend(name, {});

@@ -15,6 +15,12 @@
 
 namespace flatmarch::conformance {
 
+// A case's key in an expectation file: RENDERER/METHOD/SCENE.
+inline std::string case_key(const std::string& renderer, const std::string& method,
+                            const std::string& scene) {
+  return renderer + "/" + method + "/" + scene;
+}
+
 class Expectations {
  public:
   Expectations() = default;

@@ -595,7 +595,7 @@ std::string ExternalSkips::why(const Backend& backend, Method m, const Scene& sc
   if (std::string why = info->cannot_read(scene); !why.empty()) return why;
   const auto file = files_.find(backend.name());
   if (file != files_.end() &&
-      file->second.skipped(backend.name() + "/" + to_string(m) + "/" + scene.name))
+      file->second.skipped(case_key(backend.name(), to_string(m), scene.name)))
     return "its expectation file skips it (" + file->second.file() + ")";
   return {};
 }
