@@ -13,7 +13,7 @@ export LSAN_OPTIONS="suppressions=$root/ci/lsan.supp"
 # bits on AVX2 and AVX-512 CPUs. A CI machine's shader cache is cold, so that compile is most of
 # the GPU tests' time, and on an AVX-512 Intel Xeon (Emerald Rapids; Mesa 22.3.6, LLVM 15) it
 # took many times as long at 256 bits as at 128: the cube's Vulkan frame 22.6 s against 1.5 s,
-# the ctest stage 736 s against 636 s (docs/tests.md). The width is how many pixels a driver's
+# the ctest stage 736 s against 609 s (docs/tests.md). The width is how many pixels a driver's
 # loop takes at once: the frames are the same, and the tests hold them to the oracle either way.
 # The cache is the tests' own: Mesa's cache key leaves the width out, so a user's cache would
 # hand these 128-bit programs to later runs at the driver's default.
