@@ -1,5 +1,6 @@
 #include "reports/matrix.hpp"
 
+#include "conformance/expectations.hpp"
 #include "conformance/external.hpp"
 
 #include <benchmark/benchmark.h>
@@ -304,7 +305,7 @@ std::map<std::string, Timing> timings(const json& document) {
 
 std::string matrix_case_key(const std::string& backend, const std::string& method,
                             const std::string& scene) {
-  return "matrix/" + backend + "/" + method + "/" + scene;
+  return "matrix/" + conformance::case_key(backend, method, scene);
 }
 
 std::optional<CaseKey> parse_case_key(const std::string& key) {
@@ -335,7 +336,7 @@ std::vector<std::pair<std::string, double>> compile_cases(
     // A case's three programs on llvmpipe and lavapipe (a 2-core Zen 5, two cases at once):
     // 0.5-0.6 s in a scene of one room, about 1.8 s in two, 3.7-6.6 s in the cube's six.
     const double rooms = static_cast<double>(scene->second->polygons.size());
-    out.emplace_back("compile/" + k->backend + "/" + k->method + "/" + k->scene,
+    out.emplace_back("compile/" + conformance::case_key(k->backend, k->method, k->scene),
                      0.5 + (rooms - 1.0));
   }
   return out;
