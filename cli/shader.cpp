@@ -29,9 +29,10 @@ void add_shader(CLI::App& app) {
       "Print the GLSL shader a GPU backend runs for a scene's whole frames: the opengl backend's\n"
       "fragment shader (--kernel-shape software) or compute shader (gpu), or the vulkan backend's\n"
       "compute shader (--backend vulkan), the kernel specialised on the features the scene uses,\n"
-      "with its tables baked in as constants. The march parameters are baked in too (a change of\n"
-      "method or eps is a new program). --compile compiles it (or a file of yours with --file)\n"
-      "and shows any error with the lines around it.");
+      "with its tables baked in as constants (a scene of several rooms: read from a storage\n"
+      "buffer, binding 6, which the backend fills). The march parameters are baked in either way\n"
+      "(a change of method or eps is a new program). --compile compiles it (or a file of yours\n"
+      "with --file) and shows any error with the lines around it.");
   struct Options {
     std::string scene, file, out, backend, shape = "software";
     bool trace = false, compile = false;

@@ -1,5 +1,6 @@
 #include "kernels/scene_shader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -213,6 +214,52 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays)
   return s + baked_params(tables.params);
 }
 
+bool tables_in_buffer(const SceneTables<float>& tables) {
+  return tables.polygons.size() > 1;
+}
+
+namespace {
+
+// Appends a table's records, or one zero record where it has none (as `array` declares it).
+template <typename Record>
+void append_records(std::string& bytes, const std::vector<Record>& records) {
+  static_assert(sizeof(Record) % 16 == 0, "std430 lays the records out as C++ does");
+  if (records.empty()) {
+    bytes.append(sizeof(Record), '\0');
+    return;
+  }
+  bytes.append(reinterpret_cast<const char*>(records.data()), records.size() * sizeof(Record));
+}
+
+// The tables' declaration in a shader that reads them from the table buffer: one block of the
+// three arrays at their sizes (so that a loop over the objects still has a constant bound).
+std::string buffered_tables(const SceneTables<float>& tables) {
+  const auto count = [](size_t n) { return std::to_string(std::max<size_t>(n, 1)); };
+  std::string s = "\n// The scene's tables, from the table buffer (several rooms).\n";
+  s += "layout(std430, binding = " + std::to_string(kTableBinding) +
+       ") readonly buffer SceneTableBuffer {\n  ivec4 polygons[" + count(tables.polygons.size()) +
+       "];\n  EdgeRecord edges[" + count(tables.edges.size()) + "];\n  ObjectRecord objects[" +
+       count(tables.objects.size()) + "];\n};\n";
+  if (tables.objects.size() <= kFewObjects) s += "#define FLATMARCH_FEW_OBJECTS\n";
+  return s + baked_params(tables.params);
+}
+
+// A frame or trace shader's tables: baked in (`const` arrays or plain ones) or from the buffer.
+std::string scene_tables(const SceneTables<float>& tables, bool constant_arrays) {
+  return tables_in_buffer(tables) ? buffered_tables(tables) : baked_tables(tables, constant_arrays);
+}
+
+}  // namespace
+
+std::string table_buffer(const SceneTables<float>& tables) {
+  std::string bytes;
+  if (!tables_in_buffer(tables)) return bytes;
+  append_records(bytes, tables.polygons);
+  append_records(bytes, tables.edges);
+  append_records(bytes, tables.objects);
+  return bytes;
+}
+
 namespace {
 
 // The defines that pick a variant's code, after the baked tables.
@@ -233,7 +280,7 @@ bool within_band(const SceneTables<float>& tables, const glm::dvec3& position) {
 }
 
 std::string scene_fragment_shader(const SceneTables<float>& tables, const ShaderVariant& v) {
-  return shader_source(tables.features, baked_tables(tables) + variant_defines(v), v.trace) +
+  return shader_source(tables.features, scene_tables(tables, true) + variant_defines(v), v.trace) +
          kFragmentMain;
 }
 
@@ -241,7 +288,7 @@ std::string scene_compute_shader(const SceneTables<float>& tables, const ShaderV
                                  ComputeApi api) {
   ShaderVariant compute = v;
   if (compute.readback == Readback::floats) compute.readback = Readback::all;
-  return shader_source(tables.features, baked_tables(tables, false) + variant_defines(compute),
+  return shader_source(tables.features, scene_tables(tables, false) + variant_defines(compute),
                        v.trace) +
          (api == ComputeApi::opengl ? "#define FLATMARCH_GL_COMPUTE\n" : "") + "#define TILE " +
          std::to_string(kComputeTile) + "\n" + kComputeMain;

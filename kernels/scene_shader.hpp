@@ -19,6 +19,24 @@ namespace flatmarch::kernel {
 // `constant_arrays`: declare the tables `const` (false: plain globals with the same initialisers).
 std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays = true);
 
+// Where a scene's shader reads its tables. One room: baked in (baked_tables), its loops over the
+// room's edges unrolled and their reads folded into constants. Several rooms: from a read-only
+// storage buffer (binding kTableBinding, table_buffer's bytes), since a ray's room is known only
+// at run time. Baked, such tables are arrays that every invocation fills before it marches, and
+// LLVM's code generation for llvmpipe and lavapipe grows steeply with them: on a 2-vCPU Intel
+// Xeon (AVX-512, Mesa 22.3.6, LLVM 15, 256-bit vectors) a Vulkan frame program of the cube (six
+// rooms) compiled in 15.8 s, from the buffer in 0.3 s. Its frames are the same pixels, but the
+// buffer's reads are dearer there than the arrays' (per lane, bounds-checked): frames of the
+// several-room scenes 1.1-1.8x slower (docs/vulkan.md). On a GPU a dynamically indexed array is
+// per-thread scratch memory, and a buffer the usual place for such tables (not measured here).
+// The parameters are baked in either way.
+bool tables_in_buffer(const SceneTables<float>& tables);
+constexpr int kTableBinding = 6;
+// The buffer's bytes (std430): polygons, edges, objects, as the block scene_fragment_shader and
+// scene_compute_shader declare them (an empty table is one zero record); empty where the
+// tables are baked in.
+std::string table_buffer(const SceneTables<float>& tables);
+
 // What a frame's shader writes, and its backend reads back.
 enum class Readback {
   // The colour alone, tone-mapped and sRGB-encoded (as OpenImageIO writes the PNGs): one uint a
@@ -47,7 +65,8 @@ struct ShaderVariant {
   Readback readback = Readback::floats;       // a frame's outputs (not a trace's)
 };
 
-// Uniforms of the fragment shader (scene_fragment_shader):
+// Uniforms of the fragment shader (scene_fragment_shader), and its table buffer where
+// tables_in_buffer:
 //   u_polygon, u_from         the camera's polygon and position
 //   u_forward, u_right, u_up  its basis (kernels/camera.hpp)
 //   u_scale                   (aspect * tan(fov / 2), tan(fov / 2))
@@ -87,11 +106,12 @@ bool within_band(const SceneTables<float>& tables, const glm::dvec3& position);
 // 16-byte stores a pixel ran up to 1.2x faster on lavapipe than seven planar float stores). The
 // trace variant (one invocation) marches the ray from `from` along `forward` in polygon frame.w
 // and writes its events to binding 4 as the fragment shader's does.
-// Its tables are not `const` arrays but plain ones with the same initialisers: glslang gives a
-// dynamically indexed `const` array a function-local copy at each use (344 in the cube), which
-// lavapipe took 35 s to compile (the plain arrays: 2.4 s, and 0.3 s once SPIRV-Tools' optimiser
-// has run, which in turn made the `const` arrays' copies run 300x slower). Tables in buffers ran
-// 1.4-15x slower: their loads are not folded where the indices are constant.
+// Baked in (one room: tables_in_buffer), its tables are not `const` arrays but plain ones with
+// the same initialisers: glslang gives a dynamically indexed `const` array a function-local copy
+// at each use (344 in the cube), which lavapipe took 35 s to compile (the plain arrays: 2.4 s, and
+// 0.3 s once SPIRV-Tools' optimiser has run, which in turn made the `const` arrays' copies run
+// 300x slower). A one-room scene's tables in buffers ran 1.4-15x slower: their loads are not
+// folded where the indices are constant.
 enum class ComputeApi { vulkan, opengl };
 std::string scene_compute_shader(const SceneTables<float>& tables,
                                  const ShaderVariant& variant = {},

@@ -10,6 +10,7 @@
 
 #include "backends/bands.hpp"
 #include "backends/scalar/scalar.hpp"
+#include "kernels/scene_shader.hpp"
 #include "tests/gallery.hpp"
 
 namespace flatmarch::test {
@@ -61,6 +62,50 @@ inline void expect_band_views_as_scalar(const Backend& backend) {
       EXPECT_GT(entered, want.hit.size() / 8) << name << ": the view must see the rooms";
     }
   }
+}
+
+// A scene of several rooms reads its tables from a buffer (kernel::tables_in_buffer), so two such
+// scenes that differ in their tables alone have one shader: the cube, the cube with its solid
+// moved and grown, and the cube again, drawn one after the other, must each see what the scalar
+// kernel sees, whichever program a backend keeps.
+inline void expect_each_scene_its_own_tables(const Backend& backend) {
+  const Scene& cube = gallery_scene("cube");
+  Scene moved = cube;
+  moved.objects.at(0).center = Vec3(0.6, 1.3, 1.0);
+  moved.objects.at(0).size = 0.4;
+  const kernel::SceneTables<float> a = kernel::compile_scene<float>(cube, {}),
+                                   b = kernel::compile_scene<float>(moved, {});
+  ASSERT_TRUE(kernel::tables_in_buffer(a));
+  ASSERT_NE(kernel::table_buffer(a), kernel::table_buffer(b));
+  ASSERT_EQ(kernel::scene_compute_shader(a), kernel::scene_compute_shader(b));
+  ASSERT_EQ(kernel::scene_fragment_shader(a), kernel::scene_fragment_shader(b));
+  constexpr int kWidth = 64, kHeight = 36;
+  std::vector<Frame> scalar;
+  for (const Scene* scene : {&cube, static_cast<const Scene*>(&moved), &cube}) {
+    const Frame want = ScalarBackend().render(*scene, scene->camera, kWidth, kHeight, {}, {});
+    const Frame got = backend.render(*scene, scene->camera, kWidth, kHeight, {}, {});
+    size_t differ = 0;
+    for (size_t px = 0; px < want.hit.size(); ++px)
+      differ += got.hit[px] != want.hit[px] || got.crossings[px] != want.crossings[px];
+    EXPECT_LE(differ, want.hit.size() / 100)
+        << scene->objects[0].size << ": " << differ << " pixels differ from the scalar kernel's";
+    scalar.push_back(want);
+    // A probe ray towards where the solid is in the moved scene: its events as the scalar's.
+    const Ray probe{scene->camera.polygon, scene->camera.position,
+                    glm::normalize(Vec3(0.6, 1.3, 1.0) - scene->camera.position)};
+    const Trace want_trace = ScalarBackend().trace(*scene, probe, {}, 16);
+    const Trace got_trace = backend.trace(*scene, probe, {}, 16);
+    ASSERT_EQ(got_trace.events.size(), want_trace.events.size()) << scene->objects[0].size;
+    for (size_t k = 0; k < want_trace.events.size(); ++k) {
+      EXPECT_EQ(got_trace.events[k].kind, want_trace.events[k].kind) << k;
+      EXPECT_EQ(got_trace.events[k].polygon, want_trace.events[k].polygon) << k;
+    }
+  }
+  // The two scenes look different where the solid moved.
+  size_t moved_pixels = 0;
+  for (size_t px = 0; px < scalar[0].hit.size(); ++px)
+    moved_pixels += scalar[0].hit[px] != scalar[1].hit[px];
+  EXPECT_GT(moved_pixels, scalar[0].hit.size() / 50);
 }
 
 // A frame of the colour alone (Backend::render_colour) holds the whole frame's colour as a PNG

@@ -189,6 +189,28 @@ DeviceTiming DeviceClock::read() {
   return t;
 }
 
+namespace {
+
+// A buffer of the scene's tables where its shader reads them from one (kernels/scene_shader.hpp's
+// tables_in_buffer), else 0.
+GLuint make_table_buffer(const Api& gl, const kernel::SceneTables<float>& tables) {
+  const std::string bytes = kernel::table_buffer(tables);
+  if (bytes.empty()) return 0;
+  GLuint id = 0;
+  gl.GenBuffers(1, &id);
+  gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, id);
+  gl.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(bytes.size()), bytes.data(),
+                GL_STATIC_DRAW);
+  gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+  return id;
+}
+
+void bind_tables(const Api& gl, GLuint tables) {
+  if (tables != 0) gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, kernel::kTableBinding, tables);
+}
+
+}  // namespace
+
 KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables,
                              const kernel::ShaderVariant& variant)
     : gl_(gl), trace_(variant.trace) {
@@ -204,17 +226,20 @@ KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& ta
   rows_ = gl.GetUniformLocation(program_, "u_rows");
   gl.GenVertexArrays(1, &vertex_array_);  // the core profile draws only with one bound
   if (trace_) gl.GenBuffers(1, &events_);
+  tables_ = make_table_buffer(gl, tables);
 }
 
 KernelProgram::~KernelProgram() {
   gl_.DeleteProgram(program_);
   gl_.DeleteVertexArrays(1, &vertex_array_);
   if (events_ != 0) gl_.DeleteBuffers(1, &events_);
+  if (tables_ != 0) gl_.DeleteBuffers(1, &tables_);
 }
 
 void KernelProgram::draw(const CameraBasis<float>& c, int polygon, glm::vec3 from, int width,
                          int height, Rows rows) const {
   gl_.UseProgram(program_);
+  bind_tables(gl_, tables_);
   gl_.Uniform1i(polygon_, polygon);
   gl_.Uniform3f(from_, from.x, from.y, from.z);
   gl_.Uniform3f(forward_, c.forward.x, c.forward.y, c.forward.z);
@@ -235,6 +260,8 @@ Trace KernelProgram::trace(const Ray& ray, int max_events) const {
   max_events = std::max(max_events, 0);
   const size_t bytes = shader_trace_bytes(max_events);
   const ShaderEventHeader header{0, max_events, 0, 0};
+  // (Binding the tables binds their buffer to the generic binding point too: before the events'.)
+  bind_tables(gl_, tables_);
   gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, events_);
   gl_.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(bytes), nullptr,
                  GL_DYNAMIC_READ);
@@ -262,11 +289,13 @@ ComputeProgram::ComputeProgram(const Api& gl, const kernel::SceneTables<float>& 
   gl.GenBuffers(1, &constants_);
   gl.BindBuffer(GL_UNIFORM_BUFFER, constants_);
   gl.BufferData(GL_UNIFORM_BUFFER, sizeof(kernel::ComputeConstants), nullptr, GL_DYNAMIC_DRAW);
+  tables_ = make_table_buffer(gl, tables);
 }
 
 ComputeProgram::~ComputeProgram() {
   gl_.DeleteProgram(program_);
   gl_.DeleteBuffers(1, &constants_);
+  if (tables_ != 0) gl_.DeleteBuffers(1, &tables_);
 }
 
 void ComputeProgram::dispatch(const kernel::ComputeConstants& constants, GLuint groups_x,
@@ -275,6 +304,7 @@ void ComputeProgram::dispatch(const kernel::ComputeConstants& constants, GLuint 
   gl_.BindBuffer(GL_UNIFORM_BUFFER, constants_);
   gl_.BufferSubData(GL_UNIFORM_BUFFER, 0, sizeof constants, &constants);
   gl_.BindBufferBase(GL_UNIFORM_BUFFER, 0, constants_);
+  bind_tables(gl_, tables_);
   gl_.DispatchCompute(groups_x, tile_rows, 1);
 }
 

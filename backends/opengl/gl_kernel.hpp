@@ -93,8 +93,9 @@ class DeviceClock {
   double seconds_[2] = {0.0, 0.0};
 };
 
-// The compiled fragment kernel of one scene, one set of march parameters (both baked in) and one
-// variant (kernels/scene_shader.hpp).
+// The compiled fragment kernel of one scene, one set of march parameters (both baked in, or the
+// scene's tables in a buffer of the program's: kernels/scene_shader.hpp's tables_in_buffer) and
+// one variant.
 class KernelProgram {
  public:
   KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables,
@@ -125,6 +126,7 @@ class KernelProgram {
   const Api& gl_;
   bool trace_;
   GLuint program_ = 0, vertex_array_ = 0, events_ = 0;
+  GLuint tables_ = 0;  // the scene's table buffer, where its shader reads one
   GLint polygon_ = -1, from_ = -1, forward_ = -1, right_ = -1, up_ = -1, scale_ = -1, size_ = -1,
         rows_ = -1;
   mutable double seconds_per_pixel_ = 0.0;
@@ -150,6 +152,7 @@ class ComputeProgram {
  private:
   const Api& gl_;
   GLuint program_ = 0, constants_ = 0;
+  GLuint tables_ = 0;  // as KernelProgram's
   mutable double seconds_per_pixel_ = 0.0;
 };
 

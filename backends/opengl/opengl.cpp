@@ -35,7 +35,7 @@ struct OpenGlBackend::Context {
   std::unique_ptr<gl::Buffer> readback, pixels;
   std::unique_ptr<gl::DeviceClock> clock;
   DeviceTiming timing;  // of the last frame
-  // Programs by their source.
+  // Programs by their source and the table buffer they bind (kernels/scene_shader.hpp).
   LruCache<std::string, std::unique_ptr<gl::KernelProgram>> programs{kProgramCache};
   LruCache<std::string, std::unique_ptr<gl::ComputeProgram>> kernels{kProgramCache};
 
@@ -43,15 +43,16 @@ struct OpenGlBackend::Context {
 
   gl::KernelProgram& program(const kernel::SceneTables<float>& tables,
                              const kernel::ShaderVariant& variant) {
-    return *programs.get(kernel::scene_fragment_shader(tables, variant), [&] {
-      return std::make_unique<gl::KernelProgram>(gl(), tables, variant);
-    });
+    return *programs.get(
+        kernel::scene_fragment_shader(tables, variant) + kernel::table_buffer(tables),
+        [&] { return std::make_unique<gl::KernelProgram>(gl(), tables, variant); });
   }
 
   gl::ComputeProgram& compute(const kernel::SceneTables<float>& tables,
                               const kernel::ShaderVariant& variant) {
     return *kernels.get(
-        kernel::scene_compute_shader(tables, variant, kernel::ComputeApi::opengl),
+        kernel::scene_compute_shader(tables, variant, kernel::ComputeApi::opengl) +
+            kernel::table_buffer(tables),
         [&] { return std::make_unique<gl::ComputeProgram>(gl(), tables, variant); });
   }
 

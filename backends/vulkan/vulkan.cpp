@@ -42,7 +42,8 @@ constexpr uint64_t kWholeFrameTimeoutNs = 3'600'000'000'000;
 constexpr uint32_t kTimestamps = 3;
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 // The storage buffers of kernels/scene_shader.hpp.
-constexpr uint32_t kEventsBinding = 4, kPixelsBinding = 5;
+constexpr uint32_t kEventsBinding = 4, kPixelsBinding = 5,
+                   kTableBinding = static_cast<uint32_t>(kernel::kTableBinding);
 
 std::mutex& messages_mutex() {
   static std::mutex m;
@@ -173,8 +174,9 @@ struct VulkanBackend::Context {
   vk::raii::DescriptorPool descriptor_pool = nullptr;
   vk::raii::DescriptorSet set = nullptr;
   // The pixels (written by the shader; read back directly where the device's memory is
-  // host-visible and cached, else copied to `staging`) and the trace's events.
-  Buffer pixels, staging, events;
+  // host-visible and cached, else copied to `staging`), the trace's events and the scene's
+  // tables where they are not baked in (kernels/scene_shader.hpp's tables_in_buffer).
+  Buffer pixels, staging, events, table_buffer;
   bool read_directly = false;
   bool force_staging = false;  // BackendOptions::vk_staging
   bool software = false;       // the device is a CPU (lavapipe)
@@ -272,15 +274,37 @@ struct VulkanBackend::Context {
     write_descriptors();
   }
 
+  // The scene's tables, where its shader reads them from the table buffer; read by the device
+  // from host-visible memory (device-local too where there is such memory).
+  void load_tables(const kernel::SceneTables<float>& scene) {
+    const std::string bytes = kernel::table_buffer(scene);
+    if (bytes.empty()) return;
+    reserve_tables(bytes.size());
+    std::memcpy(table_buffer.mapped, bytes.data(), bytes.size());
+  }
+
+  void reserve_tables(vk::DeviceSize bytes) {
+    if (table_buffer.size >= bytes) return;
+    table_buffer = make_buffer(
+        std::max<vk::DeviceSize>(bytes, 2 * table_buffer.size),
+        vk::BufferUsageFlagBits::eStorageBuffer,
+        vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent,
+        vk::MemoryPropertyFlagBits::eDeviceLocal);
+    write_descriptors();
+  }
+
   void write_descriptors() {
-    if (!*pixels.buffer || !*events.buffer) return;
+    if (!*pixels.buffer || !*events.buffer || !*table_buffer.buffer) return;
     const vk::DescriptorBufferInfo events_info(*events.buffer, 0, VK_WHOLE_SIZE);
     const vk::DescriptorBufferInfo pixels_info(*pixels.buffer, 0, VK_WHOLE_SIZE);
+    const vk::DescriptorBufferInfo tables_info(*table_buffer.buffer, 0, VK_WHOLE_SIZE);
     device.updateDescriptorSets(
         {vk::WriteDescriptorSet(*set, kEventsBinding, 0, vk::DescriptorType::eStorageBuffer, {},
                                 events_info),
          vk::WriteDescriptorSet(*set, kPixelsBinding, 0, vk::DescriptorType::eStorageBuffer, {},
-                                pixels_info)},
+                                pixels_info),
+         vk::WriteDescriptorSet(*set, kTableBinding, 0, vk::DescriptorType::eStorageBuffer, {},
+                                tables_info)},
         {});
   }
 
@@ -471,10 +495,12 @@ void VulkanBackend::make_context() const {
         vk::CommandBufferAllocateInfo(*c->pool, vk::CommandBufferLevel::ePrimary, 1))[0]);
     c->fence = vk::raii::Fence(c->device, vk::FenceCreateInfo());
 
-    const std::array<vk::DescriptorSetLayoutBinding, 2> bindings{
+    const std::array<vk::DescriptorSetLayoutBinding, 3> bindings{
         vk::DescriptorSetLayoutBinding(kEventsBinding, vk::DescriptorType::eStorageBuffer, 1,
                                        vk::ShaderStageFlagBits::eCompute),
         vk::DescriptorSetLayoutBinding(kPixelsBinding, vk::DescriptorType::eStorageBuffer, 1,
+                                       vk::ShaderStageFlagBits::eCompute),
+        vk::DescriptorSetLayoutBinding(kTableBinding, vk::DescriptorType::eStorageBuffer, 1,
                                        vk::ShaderStageFlagBits::eCompute)};
     c->set_layout =
         vk::raii::DescriptorSetLayout(c->device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
@@ -483,7 +509,7 @@ void VulkanBackend::make_context() const {
     const vk::DescriptorSetLayout set_layout = *c->set_layout;
     c->layout =
         vk::raii::PipelineLayout(c->device, vk::PipelineLayoutCreateInfo({}, set_layout, push));
-    const vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, 2);
+    const vk::DescriptorPoolSize pool_size(vk::DescriptorType::eStorageBuffer, 3);
     c->descriptor_pool = vk::raii::DescriptorPool(
         c->device, vk::DescriptorPoolCreateInfo(
                        vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_size));
@@ -505,6 +531,7 @@ void VulkanBackend::make_context() const {
       c->tick_ns = c->limits.timestampPeriod;
       c->tick_mask = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
     }
+    c->reserve_tables(4096);  // the cube's 3 KB
     c->reserve_events(shader_trace_bytes(64));
     c->reserve_pixels(64 * 64 * kWholeReadbackBytes);
     context_ = std::move(c);
@@ -638,6 +665,7 @@ Frame VulkanBackend::draw(const Scene& scene, const Camera& camera, int width, i
                .readback = colour_only ? kernel::Readback::colour : kernel::Readback::all});
   const vk::Pipeline pipeline = *cached.pipeline;
   c.reserve_pixels(bytes);
+  c.load_tables(tables);
 
   const CameraBasis<float> basis = camera_basis<float>(
       float(camera.yaw_deg), float(camera.pitch_deg), float(camera.fov_deg), width, height);
@@ -736,6 +764,7 @@ Trace VulkanBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   const vk::Pipeline pipeline = *c.pipeline(tables, {.trace = true, .shape = c.shape}).pipeline;
   const size_t bytes = shader_trace_bytes(max_events);
   c.reserve_events(bytes);
+  c.load_tables(tables);
   const ShaderEventHeader header{0, max_events, 0, 0};
   std::memcpy(c.events.mapped, &header, sizeof header);
   const kernel::ComputeConstants constants{.from = glm::vec4(glm::vec3(ray.from), 0.0f),

@@ -51,8 +51,8 @@ TEST(SurfaceType, ClassifiesTheGalleryByItsHazards) {
 }
 
 // The GPU kernels compiled ahead of the matrix: a case for each matrix case of a backend that
-// compiles per scene, in the matrix's order, dearer the more rooms its scene has; a compile case
-// runs on its backend, and a key that names nothing here is refused.
+// compiles per scene, in the matrix's order, a scene of several rooms a little dearer; a compile
+// case runs on its backend, and a key that names nothing here is refused.
 TEST(CompileCases, OneForEachMatrixCaseOfTheCompilingBackends) {
   const std::vector<Scene> scenes = {gallery("torus"), gallery("cube")};
   const std::vector<std::pair<std::string, double>> cases = {
@@ -64,7 +64,9 @@ TEST(CompileCases, OneForEachMatrixCaseOfTheCompilingBackends) {
   EXPECT_EQ(compiled[0].first, "compile/gl/sphere/cube");
   EXPECT_EQ(compiled[1].first, "compile/vk/analytic/torus");
   EXPECT_EQ(compiled[2].first, "compile/gl/relaxed/torus");
-  EXPECT_GT(compiled[0].second, 5.0 * compiled[1].second);  // six rooms against one
+  // Six rooms, whose tables the kernel reads from a buffer, against one: a little dearer.
+  EXPECT_GT(compiled[0].second, compiled[1].second);
+  EXPECT_LT(compiled[0].second, 2.0 * compiled[1].second);
   EXPECT_EQ(compiled[1].second, compiled[2].second);
   EXPECT_TRUE(compile_cases(cases, scenes, {}).empty());
 

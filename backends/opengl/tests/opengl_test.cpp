@@ -46,6 +46,14 @@ TEST(OpenGl, CamerasWithinAndOutsideTheBandSeeAsTheScalarKernel) {
   test::expect_band_views_as_scalar(opengl());
 }
 
+TEST(OpenGl, ScenesOfOneShaderDrawTheirOwnTablesInEitherShape) {
+  SKIP_WITHOUT_OPENGL();
+  test::expect_each_scene_its_own_tables(opengl());
+  const OpenGlBackend other(BackendOptions{
+      .kernel_shape = opengl().device()->kernel_shape == "gpu" ? "software" : "gpu"});
+  test::expect_each_scene_its_own_tables(other);
+}
+
 TEST(OpenGlShader, ACameraWithinTheBandGetsAShaderWithoutTheEntryIntoIt) {
   const Scene& scene = test::gallery_scene("l_shape");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
@@ -43,8 +44,8 @@ TEST(VulkanShader, EveryGallerySceneCompilesToSpirvWithGlslang) {
   }
 }
 
-TEST(VulkanShader, BakesTheTablesAsPlainArraysAndSpecialises) {
-  const Scene& scene = test::gallery_scene("cube");
+TEST(VulkanShader, BakesTheTablesOfOneRoomAsPlainArraysAndSpecialises) {
+  const Scene& scene = test::gallery_scene("l_shape");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
   const std::string source = kernel::scene_compute_shader(tables);
   const std::string edges = "EdgeRecord edges[" + std::to_string(tables.edges.size()) + "]";
@@ -57,6 +58,50 @@ TEST(VulkanShader, BakesTheTablesAsPlainArraysAndSpecialises) {
   EXPECT_EQ(source.find("#define FLATMARCH_TRACE"), std::string::npos);
   EXPECT_NE(kernel::scene_compute_shader(tables, {.trace = true}).find("#define FLATMARCH_TRACE"),
             std::string::npos);
+}
+
+TEST(VulkanShader, ReadsTheTablesOfSeveralRoomsFromTheTableBuffer) {
+  const Scene& scene = test::gallery_scene("cube");
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
+  ASSERT_TRUE(kernel::tables_in_buffer(tables));
+  for (bool trace : {false, true}) {
+    const std::string source = kernel::scene_compute_shader(tables, {.trace = trace});
+    EXPECT_NE(source.find("layout(std430, binding = 6) readonly buffer SceneTableBuffer {\n"
+                          "  ivec4 polygons[6];\n  EdgeRecord edges[24];\n"
+                          "  ObjectRecord objects[1];\n};"),
+              std::string::npos);
+    EXPECT_EQ(source.find("EdgeRecord edges[24] ="), std::string::npos) << "not baked in too";
+    EXPECT_NE(source.find("const KernelParams params"), std::string::npos) << "still baked in";
+  }
+  // The buffer as std430 lays it out: six squares of four edges each, then their 24 edges
+  // (112 bytes each), then the one solid (64 bytes).
+  const std::string bytes = kernel::table_buffer(tables);
+  ASSERT_EQ(bytes.size(), 6u * 16 + 24u * 112 + 64);
+  const auto int_at = [&](size_t offset) {
+    int32_t v;
+    std::memcpy(&v, bytes.data() + offset, sizeof v);
+    return v;
+  };
+  const auto float_at = [&](size_t offset) {
+    float v;
+    std::memcpy(&v, bytes.data() + offset, sizeof v);
+    return v;
+  };
+  for (int p = 0; p < 6; ++p) {
+    EXPECT_EQ(int_at(16 * static_cast<size_t>(p)), 4 * p) << "first edge of polygon " << p;
+    EXPECT_EQ(int_at(16 * static_cast<size_t>(p) + 4), 4) << "edges of polygon " << p;
+  }
+  // The first face is the square [0, 2]^2: its first edge from (0, 0) to (2, 0).
+  EXPECT_EQ(float_at(96 + 0), 0.0f);
+  EXPECT_EQ(float_at(96 + 4), 0.0f);
+  EXPECT_EQ(float_at(96 + 8), 2.0f);
+  EXPECT_EQ(float_at(96 + 12), 0.0f);
+  // The solid's centre (1, 1, 1).
+  EXPECT_EQ(float_at(96 + 24 * 112 + 0), 1.0f);
+  EXPECT_EQ(float_at(96 + 24 * 112 + 8), 1.0f);
+  // A scene of one room bakes them in and has no buffer.
+  EXPECT_TRUE(
+      kernel::table_buffer(kernel::compile_scene<float>(test::gallery_scene("torus"), {})).empty());
 }
 
 TEST(VulkanShader, RowsOfWorkgroupsDrawEveryRowOnceInASpreadOrder) {
@@ -111,6 +156,11 @@ TEST(Vulkan, AFrameOfTheColourAloneIsTheWholeFramesColourInEitherShapeAndReadBac
 TEST(Vulkan, CamerasWithinAndOutsideTheBandSeeAsTheScalarKernel) {
   SKIP_WITHOUT_VULKAN();
   test::expect_band_views_as_scalar(vulkan());
+}
+
+TEST(Vulkan, ScenesOfOneShaderDrawTheirOwnTables) {
+  SKIP_WITHOUT_VULKAN();
+  test::expect_each_scene_its_own_tables(vulkan());
 }
 
 TEST(Vulkan, TraceKeepsAtMostMaxEventsAndCountsTheRest) {
