@@ -9,17 +9,6 @@ cd "$root"
 fuzz_seconds=${FLATMARCH_FUZZ_SECONDS:-30}
 # Mesa's drivers keep allocations for the life of a process; see ci/lsan.supp.
 export LSAN_OPTIONS="suppressions=$root/ci/lsan.supp"
-# llvmpipe and lavapipe compile each GPU case's kernel with LLVM at the CPU's vector width (256
-# bits on the AVX-512 Xeon below). A CI machine's shader cache is cold, so that compile is most of
-# the GPU tests' time, and on an AVX-512 Intel Xeon (Emerald Rapids; Mesa 22.3.6, LLVM 15) it
-# took many times as long at 256 bits as at 128: the cube's Vulkan frame 22.6 s against 1.5 s,
-# the ctest stage 736 s against 609 s (docs/tests.md). The width is how many pixels a driver's
-# loop takes at once: four frames compared were the same PNGs at 128 and 256 bits, and the tests
-# hold every frame to the oracle either way.
-# The cache is the tests' own: Mesa's cache key leaves the width out, so a user's cache would
-# hand these 128-bit programs to later runs at the driver's default.
-export LP_NATIVE_VECTOR_WIDTH=${LP_NATIVE_VECTOR_WIDTH:-128}
-export MESA_SHADER_CACHE_DIR=${MESA_SHADER_CACHE_DIR:-$root/build/mesa-shader-cache}
 
 summaries=()
 failed=0
