@@ -162,10 +162,11 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
             DeviceTimes device_times;
             try {
               // The first frames compile the programs (a GPU backend's whole frame and its
-              // frame of the colour alone are two): untimed.
+              // frame of the colour alone are two): untimed. A CPU backend compiles nothing; its
+              // frame counted below (or the whole frame, where none is) is its warm-up.
               if (!*whole) {
                 *whole = backend.render(scene, camera, width, height, params, {});
-                backend.render_colour(scene, camera, width, height, params, {});
+                if (on_device) backend.render_colour(scene, camera, width, height, params, {});
               }
               if (!*instructions_per_ray) {
                 *instructions_per_ray = 0.0;
