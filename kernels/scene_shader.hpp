@@ -26,10 +26,10 @@ std::string baked_tables(const SceneTables<float>& tables, bool constant_arrays 
 // LLVM's code generation for llvmpipe and lavapipe grows steeply with them: on a 2-vCPU Intel
 // Xeon (AVX-512, Mesa 22.3.6, LLVM 15, 256-bit vectors) a Vulkan frame program of the cube (six
 // rooms) compiled in 15.8 s, from the buffer in 0.3 s. Its frames are the same pixels, but the
-// buffer's reads are dearer there than the arrays' (per lane, bounds-checked): frames of the
-// several-room scenes 1.1-1.8x slower (docs/vulkan.md). On a GPU a dynamically indexed array is
-// per-thread scratch memory, and a buffer the usual place for such tables (not measured here).
-// The parameters are baked in either way.
+// buffer's reads are dearer there than the arrays' (per lane, bounds-checked): the several-room
+// gallery scenes' frames a median 1.3-1.4x as long (docs/vulkan.md). On a GPU a dynamically indexed
+// array is per-thread scratch memory, and a buffer the usual place for such tables (not measured
+// here). The parameters are baked in either way.
 bool tables_in_buffer(const SceneTables<float>& tables);
 constexpr int kTableBinding = 6;
 // The buffer's bytes (std430): polygons, edges, objects, as the block scene_fragment_shader and
