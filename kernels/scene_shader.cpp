@@ -58,14 +58,12 @@ uniform vec2 u_scale;
 uniform vec2 u_size;
 uniform vec2 u_rows;  // the pixel's row from the top is u_rows.x + u_rows.y * gl_FragCoord.y
 
-#ifdef FLATMARCH_COLOUR8
-layout(location = 0) out uint out_srgb;  // packUnorm4x8 of the sRGB colour
-#else
 layout(location = 0) out vec4 out_color;
-#endif
-#if defined(FLATMARCH_PACKED_AOVS)
+#if defined(FLATMARCH_READBACK)
+// Both read-backs: a frame's targets take the outputs it reads (gl_kernel.cpp's RenderTargets).
 layout(location = 1) out uvec4 out_aov;  // steps, crossings, hit (two's complement), t's bits
-#elif !defined(FLATMARCH_CANVAS) && !defined(FLATMARCH_COLOUR8)
+layout(location = 2) out uint out_srgb;  // packUnorm4x8 of the sRGB colour
+#elif !defined(FLATMARCH_CANVAS)
 layout(location = 1) out vec4 out_aov;
 #endif
 #ifdef FLATMARCH_TRACE_PICK
@@ -96,11 +94,11 @@ void main() {
   Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));
 #if defined(FLATMARCH_CANVAS)
   out_color = vec4(srgb(shade(r)), 1.0);
-#elif defined(FLATMARCH_COLOUR8)
-  out_srgb = packUnorm4x8(vec4(srgb(shade(r)), 1.0));
-#elif defined(FLATMARCH_PACKED_AOVS)
-  out_color = vec4(shade(r), 1.0);
+#elif defined(FLATMARCH_READBACK)
+  vec3 color = shade(r);
+  out_color = vec4(color, 1.0);
   out_aov = uvec4(uint(r.steps), uint(r.crossings), uint(r.hit), floatBitsToUint(r.t));
+  out_srgb = packUnorm4x8(vec4(srgb(color), 1.0));
 #else
   out_color = vec4(shade(r), 1.0);
   out_aov = vec4(float(r.steps), float(r.crossings), float(r.hit), r.t);
@@ -123,7 +121,7 @@ layout(push_constant) uniform Constants {
   vec4 up;
   vec4 scale;
   ivec4 frame;  // width, height, first row, polygon
-  ivec4 order;  // x: the stride of the rows of workgroups (row_stride)
+  ivec4 order;  // x: the stride of the rows of workgroups (row_stride); y: 1 the colour alone
 } pc;
 
 #ifdef FLATMARCH_TRACE
@@ -134,11 +132,12 @@ void main() {
 }
 #else
 layout(local_size_x = TILE, local_size_y = TILE) in;
-#ifdef FLATMARCH_COLOUR8
-layout(std430, binding = 5) writeonly buffer Pixels { uint pixels[]; };
-#else
+// One buffer in two views. A frame of the colour alone: a uint a pixel (packUnorm4x8 of the sRGB
+// colour); a whole frame: the linear colour's float bits, a uvec4 a pixel, then the AOVs, a uvec4
+// a pixel. One program writes either (pc.order.y), so that a scene has one frame program to
+// compile, not two.
 layout(std430, binding = 5) writeonly buffer Pixels { uvec4 pixels[]; };
-#endif
+layout(std430, binding = 5) writeonly buffer Colours { uint colours[]; };
 void main() {
   // The workgroups' rows draw the band's rows of tiles in a spread order (row_stride).
   uint row = (gl_WorkGroupID.y * uint(pc.order.x)) % gl_NumWorkGroups.y;
@@ -152,13 +151,13 @@ void main() {
                   normalize(pc.forward.xyz + u * pc.right.xyz + v * pc.up.xyz));
     vec3 color = shade(r);
     uint px = uint(p.y) * uint(pc.frame.x) + uint(p.x);
-#ifdef FLATMARCH_COLOUR8
-    pixels[px] = packUnorm4x8(vec4(srgb(color), 1.0));
-#else
-    uint n = uint(pc.frame.x) * uint(pc.frame.y);
-    pixels[px] = floatBitsToUint(vec4(color, 1.0));
-    pixels[n + px] = uvec4(uint(r.steps), uint(r.crossings), uint(r.hit), floatBitsToUint(r.t));
-#endif
+    if (pc.order.y != 0) {
+      colours[px] = packUnorm4x8(vec4(srgb(color), 1.0));
+    } else {
+      uint n = uint(pc.frame.x) * uint(pc.frame.y);
+      pixels[px] = floatBitsToUint(vec4(color, 1.0));
+      pixels[n + px] = uvec4(uint(r.steps), uint(r.crossings), uint(r.hit), floatBitsToUint(r.t));
+    }
   }
 }
 #endif
@@ -267,8 +266,8 @@ std::string variant_defines(const ShaderVariant& v) {
   std::string s;
   if (v.from_band && !v.trace) s += "#define FLATMARCH_FROM_BAND\n";
   if (v.shape == KernelShape::gpu) s += "#define FLATMARCH_GPU_SHAPE\n";
-  if (!v.trace && v.readback == Readback::colour) s += "#define FLATMARCH_COLOUR8\n";
-  if (!v.trace && v.readback == Readback::all) s += "#define FLATMARCH_PACKED_AOVS\n";
+  // A frame of the colour alone and a whole frame: one source, the outputs of both.
+  if (!v.trace && v.readback != Readback::floats) s += "#define FLATMARCH_READBACK\n";
   return s;
 }
 

@@ -161,12 +161,15 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
             DeviceTimes device_times;
             try {
-              // The first frames compile the programs (a GPU backend's whole frame and its
-              // frame of the colour alone are two): untimed. A CPU backend compiles nothing; its
-              // frame counted below (or the whole frame, where none is) is its warm-up.
+              // The first frames compile the programs, untimed: a whole frame and one of the
+              // colour alone share a program, but llvmpipe compiles a fragment shader again for
+              // each set of targets. A CPU backend compiles nothing, and webgl's frames of the
+              // colour are its whole frames: the frame counted below (or the whole frame, where
+              // none is) is their warm-up.
               if (!*whole) {
                 *whole = backend.render(scene, camera, width, height, params, {});
-                if (on_device) backend.render_colour(scene, camera, width, height, params, {});
+                if (backend.compiles_per_scene())
+                  backend.render_colour(scene, camera, width, height, params, {});
               }
               if (!*instructions_per_ray) {
                 *instructions_per_ray = 0.0;

@@ -253,7 +253,7 @@ Frame OpenGlBackend::draw(const Scene& scene, const Camera& camera, int width, i
         .up = glm::vec4(basis.up, 0.0f),
         .scale = glm::vec4(basis.aspect * basis.tan_half_fov, basis.tan_half_fov, 0.0f, 0.0f),
         .frame = glm::ivec4(width, height, 0, camera.polygon),
-        .order = glm::ivec4(1, 0, 0, 0)};
+        .order = glm::ivec4(1, colour_only ? 1 : 0, 0, 0)};
     program.set_seconds_per_pixel(
         draw_bands(gl, clock, program.seconds_per_pixel(), width, height, kernel::kComputeTile, why,
                    progress, [&](int row, int rows) {

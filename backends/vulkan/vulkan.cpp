@@ -677,7 +677,7 @@ Frame VulkanBackend::draw(const Scene& scene, const Camera& camera, int width, i
       .up = glm::vec4(basis.up, 0.0f),
       .scale = glm::vec4(basis.aspect * basis.tan_half_fov, basis.tan_half_fov, 0.0f, 0.0f),
       .frame = glm::ivec4(width, height, 0, camera.polygon),
-      .order = glm::ivec4(1, 0, 0, 0)};  // each band's, below
+      .order = glm::ivec4(1, colour_only ? 1 : 0, 0, 0)};  // x: each band's, below
   const Banding why = banding(static_cast<bool>(progress), c.software);
   BandPacer bands(cached.pace, width, height, kernel::kComputeTile, why);
   const bool timed = *c.timestamps;

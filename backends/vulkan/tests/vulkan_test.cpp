@@ -60,6 +60,24 @@ TEST(VulkanShader, BakesTheTablesOfOneRoomAsPlainArraysAndSpecialises) {
             std::string::npos);
 }
 
+TEST(VulkanShader, AFrameOfTheColourAndAWholeFrameShareOneProgram) {
+  // One program a scene for both read-backs (the push constants' order.y picks the outputs), so
+  // that the matrix compiles a frame program and a trace program a case, not three programs.
+  for (const char* name : {"l_shape", "cube"}) {
+    const kernel::SceneTables<float> tables =
+        kernel::compile_scene<float>(test::gallery_scene(name), {});
+    for (const kernel::ComputeApi api : {kernel::ComputeApi::vulkan, kernel::ComputeApi::opengl}) {
+      const std::string colour =
+          kernel::scene_compute_shader(tables, {.readback = kernel::Readback::colour}, api);
+      EXPECT_EQ(colour,
+                kernel::scene_compute_shader(tables, {.readback = kernel::Readback::all}, api))
+          << name;
+      EXPECT_NE(colour.find("colours[px] = packUnorm4x8"), std::string::npos) << name;
+      EXPECT_NE(colour.find("pixels[n + px] = uvec4("), std::string::npos) << name;
+    }
+  }
+}
+
 TEST(VulkanShader, ReadsTheTablesOfSeveralRoomsFromTheTableBuffer) {
   const Scene& scene = test::gallery_scene("cube");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
