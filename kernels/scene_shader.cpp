@@ -58,12 +58,14 @@ uniform vec2 u_scale;
 uniform vec2 u_size;
 uniform vec2 u_rows;  // the pixel's row from the top is u_rows.x + u_rows.y * gl_FragCoord.y
 
+#ifdef FLATMARCH_COLOUR8
+layout(location = 0) out uint out_srgb;  // packUnorm4x8 of the sRGB colour
+#else
 layout(location = 0) out vec4 out_color;
-#if defined(FLATMARCH_READBACK)
-// Both read-backs: a frame's targets take the outputs it reads (gl_kernel.cpp's RenderTargets).
+#endif
+#if defined(FLATMARCH_PACKED_AOVS)
 layout(location = 1) out uvec4 out_aov;  // steps, crossings, hit (two's complement), t's bits
-layout(location = 2) out uint out_srgb;  // packUnorm4x8 of the sRGB colour
-#elif !defined(FLATMARCH_CANVAS)
+#elif !defined(FLATMARCH_CANVAS) && !defined(FLATMARCH_COLOUR8)
 layout(location = 1) out vec4 out_aov;
 #endif
 #ifdef FLATMARCH_TRACE_PICK
@@ -94,11 +96,11 @@ void main() {
   Ray r = march(u_polygon, u_from, normalize(u_forward + u * u_right + v * u_up));
 #if defined(FLATMARCH_CANVAS)
   out_color = vec4(srgb(shade(r)), 1.0);
-#elif defined(FLATMARCH_READBACK)
-  vec3 color = shade(r);
-  out_color = vec4(color, 1.0);
+#elif defined(FLATMARCH_COLOUR8)
+  out_srgb = packUnorm4x8(vec4(srgb(shade(r)), 1.0));
+#elif defined(FLATMARCH_PACKED_AOVS)
+  out_color = vec4(shade(r), 1.0);
   out_aov = uvec4(uint(r.steps), uint(r.crossings), uint(r.hit), floatBitsToUint(r.t));
-  out_srgb = packUnorm4x8(vec4(srgb(color), 1.0));
 #else
   out_color = vec4(shade(r), 1.0);
   out_aov = vec4(float(r.steps), float(r.crossings), float(r.hit), r.t);
@@ -266,8 +268,9 @@ std::string variant_defines(const ShaderVariant& v) {
   std::string s;
   if (v.from_band && !v.trace) s += "#define FLATMARCH_FROM_BAND\n";
   if (v.shape == KernelShape::gpu) s += "#define FLATMARCH_GPU_SHAPE\n";
-  // A frame of the colour alone and a whole frame: one source, the outputs of both.
-  if (!v.trace && v.readback != Readback::floats) s += "#define FLATMARCH_READBACK\n";
+  // The fragment shader's outputs; the compute shader writes either read-back (kComputeMain).
+  if (!v.trace && v.readback == Readback::colour) s += "#define FLATMARCH_COLOUR8\n";
+  if (!v.trace && v.readback == Readback::all) s += "#define FLATMARCH_PACKED_AOVS\n";
   return s;
 }
 
@@ -285,8 +288,9 @@ std::string scene_fragment_shader(const SceneTables<float>& tables, const Shader
 
 std::string scene_compute_shader(const SceneTables<float>& tables, const ShaderVariant& v,
                                  ComputeApi api) {
+  // One program for both read-backs (ComputeConstants::order.y picks the outputs).
   ShaderVariant compute = v;
-  if (compute.readback == Readback::floats) compute.readback = Readback::all;
+  compute.readback = Readback::floats;
   return shader_source(tables.features, scene_tables(tables, false) + variant_defines(compute),
                        v.trace) +
          (api == ComputeApi::opengl ? "#define FLATMARCH_GL_COMPUTE\n" : "") + "#define TILE " +

@@ -37,10 +37,12 @@ constexpr int kTableBinding = 6;
 // tables are baked in.
 std::string table_buffer(const SceneTables<float>& tables);
 
-// What a frame's backend reads back. A frame of the colour and a whole frame have one shader,
-// which writes the outputs of both; the frame takes those it reads (a fragment shader's targets,
-// a compute shader's ComputeConstants::order.y), so that a scene compiles one frame program, not
-// two (a first report on llvmpipe and lavapipe compiles some 300 of them).
+// What a frame's shader writes, and its backend reads back. A compute shader writes either, as
+// ComputeConstants::order.y says, so that a scene compiles one compute program for its frames,
+// not two (a first report compiles some 150 on lavapipe). A fragment shader writes one: llvmpipe
+// compiles a fragment shader again for each set of targets, and one shader for both moved a first
+// report's compiles out of its compile stage into its matrix (OpenGL, 2-vCPU Intel Xeon, cache
+// empty: compile stage 29.5 -> 20.3 s, matrix 42.6 -> 52.4 s).
 enum class Readback {
   // The colour alone, tone-mapped and sRGB-encoded (as OpenImageIO writes the PNGs): one uint a
   // pixel, packUnorm4x8's, r in the low byte. What a timed frame or a display needs.
@@ -50,7 +52,7 @@ enum class Readback {
   all,
   // The fragment shader for the viewer and the web page's read-back: the linear colour and the
   // AOVs (steps, crossings, hit, t) as floats, in two float targets (a float target can be
-  // filtered and mipmapped: the viewer's mean steps). The compute shader makes `all` of it.
+  // filtered and mipmapped: the viewer's mean steps). A compute shader has no such variant.
   floats,
 };
 
@@ -74,9 +76,9 @@ struct ShaderVariant {
 //   u_forward, u_right, u_up  its basis (kernels/camera.hpp)
 //   u_scale                   (aspect * tan(fov / 2), tan(fov / 2))
 //   u_size                    the image's width and height in pixels
-// Outputs by the variant's readback: colour and all, location 0 the linear colour (rgb, 1), 1 the
-// uvec4 of AOVs and 2 the uint of the sRGB colour (packUnorm4x8); floats, 0 the colour and 1 the
-// AOVs as a vec4. The trace variant marches one probe ray instead.
+// Outputs by the variant's readback: colour, location 0 the uint (packUnorm4x8); all, location
+// 0 the linear colour (rgb, 1) and 1 the uvec4 of AOVs; floats, 0 the colour and 1 the AOVs as
+// a vec4. The trace variant marches one probe ray instead.
 std::string scene_fragment_shader(const SceneTables<float>& tables,
                                   const ShaderVariant& variant = {});
 
@@ -105,9 +107,9 @@ bool within_band(const SceneTables<float>& tables, const glm::dvec3& position);
 // OpenGL's uniform block at binding 0): the camera's position, basis and scale as above, and
 // frame = (width, height, first row, polygon). Output: buffer binding 5, rows from the top; by
 // ComputeConstants::order.y, `uint colours[]` of the colour (Readback::colour), or `uvec4
-// pixels[]`, the colour's bits of every pixel, then the AOVs of every pixel (all; floats is taken
-// as all; two 16-byte stores a pixel ran up to 1.2x faster on lavapipe than seven planar float
-// stores): two views of one buffer, one program for both read-backs. The
+// pixels[]`, the colour's bits of every pixel, then the AOVs of every pixel (all; two 16-byte
+// stores a pixel ran up to 1.2x faster on lavapipe than seven planar float stores): two views of
+// one buffer, one program for both read-backs, whatever the variant's readback. The
 // trace variant (one invocation) marches the ray from `from` along `forward` in polygon frame.w
 // and writes its events to binding 4 as the fragment shader's does.
 // Baked in (one room: tables_in_buffer), its tables are not `const` arrays but plain ones with

@@ -162,8 +162,8 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
             DeviceTimes device_times;
             try {
               // The first frames compile the programs, untimed: a whole frame and one of the
-              // colour alone share a program, but llvmpipe compiles a fragment shader again for
-              // each set of targets. A CPU backend compiles nothing, and webgl's frames of the
+              // colour alone are one program on Vulkan, two fragment shaders on OpenGL
+              // (kernel::Readback). A CPU backend compiles nothing, and webgl's frames of the
               // colour are its whole frames: the frame counted below (or the whole frame, where
               // none is) is their warm-up.
               if (!*whole) {

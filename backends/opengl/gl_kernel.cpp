@@ -118,14 +118,8 @@ RenderTargets::RenderTargets(const Api& gl, int width, int height, kernel::Readb
 
 void RenderTargets::bind() const {
   gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
-  // A frame of the colour alone takes its shader's third output (out_srgb, location 2) into its
-  // one target; the shader's whole-frame outputs go nowhere (kernels/scene_shader.cpp).
-  const GLenum colour[3] = {GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT0};
   const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  if (readback_ == kernel::Readback::colour)
-    gl_.DrawBuffers(3, colour);
-  else
-    gl_.DrawBuffers(textures_[1] ? 2 : 1, buffers);
+  gl_.DrawBuffers(textures_[1] ? 2 : 1, buffers);
 }
 
 RenderTargets::~RenderTargets() {

@@ -74,17 +74,6 @@ TEST(OpenGlShader, ACameraWithinTheBandGetsAShaderWithoutTheEntryIntoIt) {
       << "a probe ray may start anywhere";
 }
 
-TEST(OpenGlShader, AFrameOfTheColourAndAWholeFrameShareOneFragmentShader) {
-  // Its targets take the outputs a frame reads (gl::RenderTargets): one program for both.
-  const kernel::SceneTables<float> tables =
-      kernel::compile_scene<float>(test::gallery_scene("double_pentagon"), {});
-  const std::string colour =
-      kernel::scene_fragment_shader(tables, {.readback = kernel::Readback::colour});
-  EXPECT_EQ(colour, kernel::scene_fragment_shader(tables, {.readback = kernel::Readback::all}));
-  EXPECT_NE(colour, kernel::scene_fragment_shader(tables, {.readback = kernel::Readback::floats}));
-  EXPECT_NE(colour.find("layout(location = 2) out uint out_srgb;"), std::string::npos);
-}
-
 TEST(OpenGlShader, BakesTheTablesAndSpecialisesOnTheFeatures) {
   const Scene& scene = test::gallery_scene("mirror_square");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
@@ -176,14 +165,12 @@ TEST(OpenGlCli, ShaderPrintsTheSourceAndCompileReportsErrorsWithExit2) {
 
   const std::string file = test::make_temp_dir() + "/broken.glsl";
   std::string broken = printed.out;
-  const std::string line = "out_color = vec4(color, 1.0);";  // the frame's, a vec3 in a vec4
-  ASSERT_NE(broken.find(line), std::string::npos);
-  broken.replace(broken.find(line), line.size(), "out_color = color;");
+  broken.replace(broken.find("out_color = vec4(shade(r), 1.0);"), 32, "out_color = shade(r);");
   std::ofstream(file) << broken;
   const auto failed = test::run_flatmarch({"shader", scene, "--compile", "--file", file});
   EXPECT_EQ(failed.exit_code, 2);
   EXPECT_NE(failed.err.find("error: " + file), std::string::npos) << failed.err;
-  EXPECT_NE(failed.err.find("out_color = color;"), std::string::npos) << failed.err;
+  EXPECT_NE(failed.err.find("out_color = shade(r);"), std::string::npos) << failed.err;
 }
 
 std::string scene_path(const std::string& name) {
