@@ -143,6 +143,8 @@ class Backend {
                               const MarchParams& params, const Progress& progress) const {
     return render(scene, camera, width, height, params, progress);
   }
+  // Whether render_colour() gives render()'s whole frame (false where it reads back less).
+  virtual bool colour_frames_whole() const { return true; }
   // The last render() or render_colour() on the device's own clock (GPU backends; measured, or
   // why not). Nothing from a backend that runs on no device of its own (the CPU backends).
   virtual std::optional<DeviceTiming> last_device_timing() const { return std::nullopt; }

@@ -161,23 +161,26 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
             DeviceTimes device_times;
             try {
-              // The first frames compile the programs, untimed: a whole frame and one of the
-              // colour alone are one program on Vulkan, two fragment shaders on OpenGL
-              // (kernel::Readback). A CPU backend compiles nothing, and webgl's frames of the
-              // colour are its whole frames: the frame counted below (or the whole frame, where
-              // none is) is their warm-up.
-              if (!*whole) {
+              // A GPU backend's first frames compile its programs, untimed: a whole frame and
+              // one of the colour alone are one program on Vulkan, two fragment shaders on
+              // OpenGL (kernel::Readback). Where a frame of the colour is a whole frame (the CPU
+              // backends, webgl), the first timed one is kept as the whole frame instead of
+              // drawing one more (a quarter of the scalar backend's frames in a report); the
+              // conformance case before it warmed the backend. A frame whose instructions are
+              // counted below counts the threads (oneTBB's) there are: a whole frame first.
+              const bool counting =
+                  !*instructions_per_ray && !on_device && instructions_unavailable().empty();
+              const bool whole_in_loop = backend.colour_frames_whole() && !counting;
+              if (!*whole && !whole_in_loop) {
                 *whole = backend.render(scene, camera, width, height, params, {});
-                if (backend.compiles_per_scene())
+                if (!backend.colour_frames_whole())
                   backend.render_colour(scene, camera, width, height, params, {});
               }
               if (!*instructions_per_ray) {
                 *instructions_per_ray = 0.0;
-                // After the frames above, whose threads (oneTBB's) it counts.
                 std::optional<WorkCounter> counter =
-                    on_device || !instructions_unavailable().empty()
-                        ? std::nullopt
-                        : WorkCounter::open(WorkCounter::Event::kInstructions, nullptr);
+                    counting ? WorkCounter::open(WorkCounter::Event::kInstructions, nullptr)
+                             : std::nullopt;
                 if (counter) {
                   counter->start();
                   backend.render_colour(scene, camera, width, height, params, {});
@@ -198,7 +201,9 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
                         .count());
                 state.SetIterationTime(seconds);
                 device_times.add(backend, seconds);
+                if (!*whole && whole_in_loop) *whole = f;  // after the clock
               }
+              if (!*whole) *whole = backend.render(scene, camera, width, height, params, {});
               if (!lanes->known) {
                 lanes->figures =
                     backend.lane_figures(scene, camera, width, height, params, peak_seconds);

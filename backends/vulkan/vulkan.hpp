@@ -50,6 +50,7 @@ class VulkanBackend final : public Backend {
   bool compiles_per_scene() const override { return true; }
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;
+  bool colour_frames_whole() const override { return false; }
   Frame render_colour(const Scene& scene, const Camera& camera, int width, int height,
                       const MarchParams& params, const Progress& progress) const override;
   std::optional<DeviceTiming> last_device_timing() const override;
