@@ -309,7 +309,7 @@ struct VulkanBackend::Context {
   }
 
   vk::raii::Pipeline make_pipeline(const std::string& source) {
-    const std::vector<uint32_t> spirv = vulkan::compile_compute(source);
+    const std::vector<uint32_t> spirv = vulkan::compile_compute_cached(source);
     const vk::raii::ShaderModule shader(device, vk::ShaderModuleCreateInfo({}, spirv));
     const vk::ComputePipelineCreateInfo info(
         {},

@@ -7,7 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
@@ -76,6 +79,72 @@ TEST(VulkanShader, AFrameOfTheColourAndAWholeFrameShareOneProgram) {
       EXPECT_NE(colour.find("pixels[n + px] = uvec4("), std::string::npos) << name;
     }
   }
+}
+
+std::vector<std::filesystem::path> modules_in(const std::filesystem::path& folder) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(folder))
+    if (e.path().extension() == ".spv") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(VulkanSpirvCache, AModuleIsKeptForTheNextProcessAndABrokenOneCompiledAgain) {
+  const std::string home = test::make_temp_dir();
+  ASSERT_EQ(setenv("XDG_CACHE_HOME", home.c_str(), 1), 0);
+  ASSERT_EQ(unsetenv("FLATMARCH_SPIRV_CACHE"), 0);
+  const std::filesystem::path folder = vulkan::spirv_cache_folder();
+  EXPECT_EQ(folder, std::filesystem::path(home) / "flatmarch" / "spirv");
+  const std::string source = kernel::scene_compute_shader(
+      kernel::compile_scene<float>(test::gallery_scene("l_shape"), {}));
+  const std::vector<uint32_t> compiled = vulkan::compile_compute(source);
+  EXPECT_EQ(vulkan::compile_compute_cached(source), compiled);
+  const std::vector<std::filesystem::path> files = modules_in(folder);
+  ASSERT_EQ(files.size(), 1u);
+
+  // Read back, not compiled again: a word changed in the file comes back changed.
+  const auto size = std::filesystem::file_size(files[0]);
+  {
+    std::fstream f(files[0], std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(size - 4));
+    const uint32_t marked = compiled.back() ^ 0x5a5a5a5au;
+    f.write(reinterpret_cast<const char*>(&marked), 4);
+  }
+  const std::vector<uint32_t> read = vulkan::compile_compute_cached(source);
+  ASSERT_EQ(read.size(), compiled.size());
+  EXPECT_EQ(read.back(), compiled.back() ^ 0x5a5a5a5au);
+
+  // Cut short: compiled again and written whole.
+  std::filesystem::resize_file(files[0], 10);
+  EXPECT_EQ(vulkan::compile_compute_cached(source), compiled);
+  EXPECT_EQ(std::filesystem::file_size(files[0]), size);
+  EXPECT_EQ(vulkan::compile_compute_cached(source), compiled);
+
+  // Another source, another module; and none with the cache turned off.
+  const std::string other =
+      kernel::scene_compute_shader(kernel::compile_scene<float>(test::gallery_scene("torus"), {}));
+  EXPECT_EQ(vulkan::compile_compute_cached(other), vulkan::compile_compute(other));
+  EXPECT_EQ(modules_in(folder).size(), 2u);
+  ASSERT_EQ(setenv("FLATMARCH_SPIRV_CACHE", "0", 1), 0);
+  EXPECT_TRUE(vulkan::spirv_cache_folder().empty());
+  ASSERT_EQ(unsetenv("FLATMARCH_SPIRV_CACHE"), 0);
+}
+
+TEST(VulkanSpirvCache, KeepsTheNewestModulesPastItsBound) {
+  const std::filesystem::path folder = test::make_temp_dir();
+  const auto now = std::filesystem::file_time_type::clock::now();
+  for (int k = 0; k < 5; ++k) {
+    const std::filesystem::path f = folder / ("m" + std::to_string(k) + ".spv");
+    std::ofstream(f) << k;
+    std::filesystem::last_write_time(f, now - std::chrono::hours(10 - k));  // m4 the newest
+  }
+  std::ofstream(folder / "notes.txt") << "not a module";
+  vulkan::keep_newest_modules(folder, 5, 2);  // not past its bound: all stay
+  EXPECT_EQ(modules_in(folder).size(), 5u);
+  vulkan::keep_newest_modules(folder, 4, 2);
+  EXPECT_EQ(modules_in(folder),
+            (std::vector<std::filesystem::path>{folder / "m3.spv", folder / "m4.spv"}));
+  EXPECT_TRUE(std::filesystem::exists(folder / "notes.txt"));
 }
 
 TEST(VulkanShader, ReadsTheTablesOfSeveralRoomsFromTheTableBuffer) {
