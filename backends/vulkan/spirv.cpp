@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -119,7 +120,9 @@ void write_module(const fs::path& file, const ModuleHeader& header,
   fs::create_directories(file.parent_path(), error);
   if (error) return;
   // Written aside and renamed: a process reading it meanwhile sees all of it or none.
-  const fs::path part = file.string() + "." + std::to_string(getpid()) + ".part";
+  static std::atomic<unsigned> written{0};
+  const fs::path part =
+      file.string() + "." + std::to_string(getpid()) + "." + std::to_string(written++) + ".part";
   {
     std::ofstream out(part, std::ios::binary);
     out.write(reinterpret_cast<const char*>(&header), sizeof header);
@@ -150,8 +153,12 @@ fs::path spirv_cache_folder() {
 void keep_newest_modules(const fs::path& folder, size_t most, size_t keep) {
   std::error_code error;
   std::vector<std::pair<fs::file_time_type, fs::path>> modules;
-  for (const fs::directory_entry& e : fs::directory_iterator(folder, error))
-    if (e.path().extension() == ".spv") modules.emplace_back(e.last_write_time(error), e.path());
+  // Stepped with an error_code: another process may remove a module meanwhile.
+  for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    std::error_code gone;
+    const fs::file_time_type used = it->last_write_time(gone);
+    if (it->path().extension() == ".spv" && !gone) modules.emplace_back(used, it->path());
+  }
   if (modules.size() <= most) return;
   std::sort(modules.begin(), modules.end(),
             [](const auto& a, const auto& b) { return a.first > b.first; });
