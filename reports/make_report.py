@@ -117,19 +117,14 @@ def speed_accuracy_chart(results, tables):
     for ax in axes.flat[len(types):]:
         ax.axis("off")
     for ax, t in zip(axes.flat, types):
-        # The cases of one backend, method and verdict drawn alike, so in one call (a call a case
-        # took seconds over a whole matrix).
-        points = {}
         for c, v in zip(cases, verdicts):
             if c["surface_type"] != t or "counters" not in c or "accuracy" not in c:
                 continue
             a = c["accuracy"]
-            xy = points.setdefault((c["backend"], c["method"], v), ([], []))
-            xy[0].append(c["counters"]["rays_per_s"] / 1e6)
-            xy[1].append(max(100 * (a["hit_mismatch"] + a["crossings_mismatch"]) / 2, 1e-3))
-        for (backend, method, v), (x, y) in points.items():
-            colour = BACKEND_COLOURS.get(backend, "k")
-            ax.scatter(x, y, s=36, marker=METHOD_MARKERS.get(method, "o"),
+            y = max(100 * (a["hit_mismatch"] + a["crossings_mismatch"]) / 2, 1e-3)
+            x = c["counters"]["rays_per_s"] / 1e6
+            colour = BACKEND_COLOURS.get(c["backend"], "k")
+            ax.scatter(x, y, s=36, marker=METHOD_MARKERS.get(c["method"], "o"),
                        facecolors=colour if v == "pass" else "none", edgecolors=colour, linewidths=1.3,
                        linestyle="-" if v != "limit" else (0, (1.5, 1)))
             if v == "fail":
