@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include "backends/oracle/oracle.hpp"
@@ -70,6 +71,70 @@ Event gluing(int edge, Vec3 at, double t) {
   e.t = t;
   e.at = at;
   return e;
+}
+
+// compare_regions by its definition, pixel by pixel with delta_e (hand-written here): the
+// regions it finds, their compared and failed pixels and their worst difference, on a frame of
+// the scalar backend with a few pixels' colours pushed away and a few hits changed.
+TEST(Regions, AsTheirDefinitionSaysPixelByPixel) {
+  const Scene scene = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
+                                            "radius": 0.4}], "camera": {"position": [0.5, 0.7, 1],
+                                            "yaw_deg": 20})");
+  MarchParams params;
+  params.method = Method::analytic;
+  const int w = 48, h = 27;
+  const Frame truth = ScalarBackend().render(scene, scene.camera, w, h, params, {});
+  Frame got = truth;
+  for (size_t px = 0; px < got.hit.size(); px += 2)  // pushed by 0 to 0.5, each a channel
+    got.rgb[3 * px + px % 3] += 0.05f * static_cast<float>((px * 37) % 11);
+  for (size_t px = 3; px < got.hit.size(); px += 97) got.hit[px] = kHitWall;
+  std::vector<uint8_t> mask(got.hit.size(), 0);
+  for (size_t px = 5; px < mask.size(); px += 31) mask[px] = 1;
+  const int objects = static_cast<int>(scene.objects.size());
+  const ColourThresholds t{.delta_e = 3.0, .failpercent = 2.0, .allowed = 2};
+
+  const auto region = [&](float hit) -> std::pair<int, int> {  // (region, index), or (-1, 0)
+    const int code = static_cast<int>(hit);
+    if (code >= objects) return {static_cast<int>(Region::marker), code - objects};
+    if (code >= 0) return {static_cast<int>(Region::object), code};
+    if (code == kHitWall) return {static_cast<int>(Region::walls), 0};
+    if (code == kHitFloor) return {static_cast<int>(Region::floor), 0};
+    if (code == kHitEscape || code == kHitMiss || code == kHitMaxDistance)  // the sky's
+      return {static_cast<int>(Region::sky), 0};
+    return {-1, 0};
+  };
+  std::map<std::pair<int, int>, RegionColour> want;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      const size_t px = truth.pixel(i, j);
+      const auto key = region(truth.hit[px]);
+      if (key.first < 0 || mask[px] || got.hit[px] != truth.hit[px] ||
+          got.crossings[px] != truth.crossings[px])
+        continue;
+      RegionColour& r = want[key];
+      ++r.pixels;
+      double nearest = 1e300;
+      for (int y = std::max(j - 1, 0); y <= std::min(j + 1, h - 1); ++y)
+        for (int x = std::max(i - 1, 0); x <= std::min(i + 1, w - 1); ++x)
+          if (region(truth.hit[truth.pixel(x, y)]) == key)
+            nearest =
+                std::min(nearest, delta_e(&got.rgb[3 * px], &truth.rgb[3 * truth.pixel(x, y)]));
+      r.failed += nearest > t.delta_e;
+      r.worst = std::max(r.worst, nearest);
+    }
+
+  const std::vector<RegionColour> regions = compare_regions(got, truth, mask, t, objects);
+  ASSERT_EQ(regions.size(), want.size());
+  ASSERT_GE(regions.size(), 2u);  // the walls and the sphere at least
+  size_t failed = 0;
+  for (const RegionColour& r : regions) {
+    const RegionColour& expected = want.at({static_cast<int>(r.region), r.hit});
+    EXPECT_EQ(r.pixels, expected.pixels) << r.name();
+    EXPECT_EQ(r.failed, expected.failed) << r.name();
+    EXPECT_EQ(r.worst, expected.worst) << r.name();
+    failed += r.failed;
+  }
+  EXPECT_GT(failed, 0u);  // the pushed colours fail somewhere
 }
 
 TEST(Traces, PositionErrorDivergenceAndLeak) {
