@@ -145,6 +145,10 @@ class Backend {
   }
   // Whether render_colour() gives render()'s whole frame (false where it reads back less).
   virtual bool colour_frames_whole() const { return true; }
+  // Whether a frame of the colour alone runs a program of its own, compiled on its first frame
+  // (OpenGL's fragment shader: one a set of targets), not the whole frame's (a compute shader
+  // writes either read-back).
+  virtual bool colour_program_apart() const { return false; }
   // The last render() or render_colour() on the device's own clock (GPU backends; measured, or
   // why not). Nothing from a backend that runs on no device of its own (the CPU backends).
   virtual std::optional<DeviceTiming> last_device_timing() const { return std::nullopt; }

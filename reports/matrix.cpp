@@ -161,19 +161,21 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
             // A backend's error (a failed compile, a lost device) ends the case, not the run.
             DeviceTimes device_times;
             try {
-              // A GPU backend's first frames compile its programs, untimed: a whole frame and
-              // one of the colour alone are one program on Vulkan, two fragment shaders on
-              // OpenGL (kernel::Readback). Where a frame of the colour is a whole frame (the CPU
-              // backends, webgl), the first timed one is kept as the whole frame instead of
-              // drawing one more (a quarter of the scalar backend's frames in a report); the
-              // conformance case before it warmed the backend. A frame whose instructions are
-              // counted below counts the threads (oneTBB's) there are: a whole frame first.
+              // A GPU backend's first frames are untimed: a whole frame, and where a frame of
+              // the colour alone is a program of its own (OpenGL's fragment shaders,
+              // kernel::Readback) one of those, which compiles it. Vulkan's one program draws
+              // both, so its second frame would only cost time (0.13 s a case on lavapipe).
+              // Where a frame of the colour is a whole frame (the CPU backends, webgl), the
+              // first timed one is kept as the whole frame instead of drawing one more (a
+              // quarter of the scalar backend's frames in a report); the conformance case
+              // before it warmed the backend. A frame whose instructions are counted below
+              // counts the threads (oneTBB's) there are: a whole frame first.
               const bool counting =
                   !*instructions_per_ray && !on_device && instructions_unavailable().empty();
               const bool whole_in_loop = backend.colour_frames_whole() && !counting;
               if (!*whole && !whole_in_loop) {
                 *whole = backend.render(scene, camera, width, height, params, {});
-                if (!backend.colour_frames_whole())
+                if (backend.colour_program_apart())
                   backend.render_colour(scene, camera, width, height, params, {});
               }
               if (!*instructions_per_ray) {
@@ -372,10 +374,12 @@ json run_compile_case(const std::string& key, const std::vector<Scene>& scenes,
   params.method = *parsed;
   const auto start = std::chrono::steady_clock::now();
   // The programs the case runs: its whole frames (the conformance frame, the timed case's
-  // first), its frames of the colour alone, a probe ray's trace; all from its camera.
+  // first), its frames of the colour alone where they are a program of their own, a probe ray's
+  // trace; all from its camera.
   constexpr int kPixels = 8;
   on.render(*scene, scene->camera, kPixels, kPixels, params, {});
-  on.render_colour(*scene, scene->camera, kPixels, kPixels, params, {});
+  if (on.colour_program_apart())
+    on.render_colour(*scene, scene->camera, kPixels, kPixels, params, {});
   const double yaw = scene->camera.yaw_deg * 3.14159265358979323846 / 180.0;
   on.trace(*scene,
            {scene->camera.polygon, scene->camera.position, Vec3(std::cos(yaw), std::sin(yaw), 0.0)},

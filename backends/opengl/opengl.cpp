@@ -174,6 +174,10 @@ Frame OpenGlBackend::render_colour(const Scene& scene, const Camera& camera, int
   return draw(scene, camera, width, height, params, progress, true);
 }
 
+bool OpenGlBackend::colour_program_apart() const {
+  return context() && context_->shape == KernelShape::software;
+}
+
 std::optional<DeviceTiming> OpenGlBackend::last_device_timing() const {
   if (!context()) return std::nullopt;
   const std::lock_guard<std::mutex> lock(context_->mutex);

@@ -35,6 +35,7 @@ class OpenGlBackend final : public Backend {
   Frame render(const Scene& scene, const Camera& camera, int width, int height,
                const MarchParams& params, const Progress& progress) const override;
   bool colour_frames_whole() const override { return false; }
+  bool colour_program_apart() const override;
   Frame render_colour(const Scene& scene, const Camera& camera, int width, int height,
                       const MarchParams& params, const Progress& progress) const override;
   std::optional<DeviceTiming> last_device_timing() const override;
