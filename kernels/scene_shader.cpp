@@ -1,9 +1,11 @@
 #include "kernels/scene_shader.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <type_traits>
 
 #include "kernels/shader_source.hpp"
 
@@ -252,8 +254,28 @@ std::string scene_tables(const SceneTables<float>& tables, bool constant_arrays)
 
 }  // namespace
 
-std::string table_buffer(const SceneTables<float>& tables) {
+bool shared_trace(const SceneTables<float>& tables) {
+  return tables.polygons.size() <= kTracePolygons && tables.objects.size() <= kTraceObjects;
+}
+
+std::string table_buffer(const SceneTables<float>& tables, bool trace) {
   std::string bytes;
+  if (trace && shared_trace(tables)) {  // as kSharedTraceTables declares them
+    static_assert(std::is_trivially_copyable_v<Tables<float>::KernelParams>);
+    bytes.append(reinterpret_cast<const char*>(&tables.params), sizeof tables.params);
+    const std::array<uint, 4> scene{tables.features, 0u, 0u, 0u};
+    bytes.append(reinterpret_cast<const char*>(scene.data()), sizeof scene);
+    const auto padded = [&](const auto& records, size_t bound) {
+      using Record = typename std::decay_t<decltype(records)>::value_type;
+      const size_t start = bytes.size();
+      append_records(bytes, records);
+      bytes.resize(start + bound * sizeof(Record), '\0');
+    };
+    padded(tables.polygons, kTracePolygons);
+    padded(tables.objects, kTraceObjects);
+    append_records(bytes, tables.edges);
+    return bytes;
+  }
   if (!tables_in_buffer(tables)) return bytes;
   append_records(bytes, tables.polygons);
   append_records(bytes, tables.edges);
@@ -262,6 +284,20 @@ std::string table_buffer(const SceneTables<float>& tables) {
 }
 
 namespace {
+
+// The tables of a trace that scenes share (shared_trace), read from the table buffer with the
+// parameters and the scene's features: what table_buffer(tables, true) holds. The edges, of any
+// number, come last.
+std::string shared_trace_tables() {
+  const auto n = [](size_t bound) { return std::to_string(bound); };
+  return "\n// A trace shared by scenes: their tables, parameters and features from the table "
+         "buffer.\nlayout(std430, binding = " +
+         std::to_string(kTableBinding) +
+         ") readonly buffer SceneTraceBuffer {\n  KernelParams params;\n  uvec4 trace_scene;  // "
+         "x: the scene's features\n  ivec4 polygons[" +
+         n(kTracePolygons) + "];\n  ObjectRecord objects[" + n(kTraceObjects) +
+         "];\n  EdgeRecord edges[];\n};\n#define FEATURES (trace_scene.x)\n";
+}
 
 // The defines that pick a variant's code, after the baked tables.
 std::string variant_defines(const ShaderVariant& v) {
@@ -282,6 +318,9 @@ bool within_band(const SceneTables<float>& tables, const glm::dvec3& position) {
 }
 
 std::string scene_fragment_shader(const SceneTables<float>& tables, const ShaderVariant& v) {
+  if (v.trace && shared_trace(tables))
+    return shader_source(kFeaturesInTables, shared_trace_tables() + variant_defines(v), true) +
+           kFragmentMain;
   return shader_source(tables.features, scene_tables(tables, true) + variant_defines(v), v.trace) +
          kFragmentMain;
 }
@@ -291,7 +330,10 @@ std::string scene_compute_shader(const SceneTables<float>& tables, const ShaderV
   // One program for both read-backs (ComputeConstants::order.y picks the outputs).
   ShaderVariant compute = v;
   compute.readback = Readback::floats;
-  return shader_source(tables.features, scene_tables(tables, false) + variant_defines(compute),
+  const bool shared = v.trace && shared_trace(tables);
+  return shader_source(shared ? kFeaturesInTables : tables.features,
+                       (shared ? shared_trace_tables() : scene_tables(tables, false)) +
+                           variant_defines(compute),
                        v.trace) +
          (api == ComputeApi::opengl ? "#define FLATMARCH_GL_COMPUTE\n" : "") + "#define TILE " +
          std::to_string(kComputeTile) + "\n" + kComputeMain;

@@ -34,8 +34,20 @@ bool tables_in_buffer(const SceneTables<float>& tables);
 constexpr int kTableBinding = 6;
 // The buffer's bytes (std430): polygons, edges, objects, as the block scene_fragment_shader and
 // scene_compute_shader declare them (an empty table is one zero record); empty where the
-// tables are baked in.
-std::string table_buffer(const SceneTables<float>& tables);
+// tables are baked in. For a `trace` shared by scenes (shared_trace): the parameters, the
+// features, the polygons and objects each padded to its table's bound, then the edges.
+std::string table_buffer(const SceneTables<float>& tables, bool trace = false);
+
+// A probe ray's trace (ShaderVariant::trace) runs one program that every scene of at most
+// kTracePolygons rooms and kTraceObjects objects shares, whatever its method and parameters: the
+// tables, the parameters and the scene's features are read from the table buffer (binding
+// kTableBinding, table_buffer(tables, true)), not baked in. A trace marches one ray, whose speed
+// is not what a case measures; a program per case was half of a first report's compiles (OpenGL
+// and Vulkan on llvmpipe and lavapipe, 2-vCPU Intel Xeon: the compile stage 58 s with them, 31 s
+// without). The same kernel source, specialised at run time instead of at compile time. A larger
+// scene's trace is a program of its own, its tables where its frames have them.
+constexpr size_t kTracePolygons = 256, kTraceObjects = 64;
+bool shared_trace(const SceneTables<float>& tables);
 
 // What a frame's shader writes, and its backend reads back. A compute shader writes either, as
 // ComputeConstants::order.y says, so that a scene compiles one compute program for its frames,

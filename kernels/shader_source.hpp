@@ -17,6 +17,8 @@ extern const char* const kBufferTables;
 // `#version 450`, the constants, the table records, `tables` (GLSL that declares `polygons`,
 // `edges`, `objects` and `params`) and the kernel's functions (march, shade). With
 // `trace`, record_event appends to the event buffer (binding 4) instead of doing nothing.
+// `features` kFeaturesInTables: `tables` defines FEATURES itself (a value read at run time).
+constexpr uint kFeaturesInTables = 0xffffffffu;
 std::string shader_source(uint features, const std::string& tables, bool trace = false);
 
 // The kernel's constants and per-lane maths (kernels/maths.glsl) alone, without `#version`, for a

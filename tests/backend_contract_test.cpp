@@ -69,20 +69,26 @@ class BackendContract : public testing::TestWithParam<Variant> {
   std::unique_ptr<Backend> backend_;
 };
 
+// On scenes of one room and of several, with mirrors, a period and solids, scene after scene
+// and method after method (the GPU backends trace with one program that every scene shares,
+// kernel::shared_trace, given each one's tables).
 TEST_P(BackendContract, TraceMatchesTheScalarKernelsSteps) {
-  const Scene& scene = test::gallery_scene("l_shape");
-  for (const Method m : backend_->methods()) {
-    MarchParams params;
-    params.method = m;
-    for (const Ray& ray : test::generic_rays(scene)) {
-      const Trace want = ScalarBackend().trace(scene, ray, params, 50);
-      const Trace got = backend_->trace(scene, ray, params, 50);
-      EXPECT_NEAR(got.steps, want.steps, step_tolerance()) << to_string(m);
-      ASSERT_EQ(got.events.size(), want.events.size()) << to_string(m);
-      for (size_t k = 0; k < want.events.size(); ++k)
-        EXPECT_EQ(got.events[k].kind, want.events[k].kind)
-            << to_string(m) << ", event " << k << ": " << test::describe(got.events[k])
-            << " where the scalar kernel has " << test::describe(want.events[k]);
+  for (const char* name : {"l_shape", "cube", "mirror_double_pentagon", "double_pentagon_prism"}) {
+    const Scene& scene = test::gallery_scene(name);
+    for (const Method m : backend_->methods()) {
+      MarchParams params;
+      params.method = m;
+      for (const Ray& ray : test::generic_rays(scene)) {
+        const Trace want = ScalarBackend().trace(scene, ray, params, 50);
+        const Trace got = backend_->trace(scene, ray, params, 50);
+        EXPECT_NEAR(got.steps, want.steps, step_tolerance()) << name << " " << to_string(m);
+        ASSERT_EQ(got.events.size(), want.events.size()) << name << " " << to_string(m);
+        for (size_t k = 0; k < want.events.size(); ++k)
+          EXPECT_EQ(got.events[k].kind, want.events[k].kind)
+              << name << " " << to_string(m) << ", event " << k << ": "
+              << test::describe(got.events[k]) << " where the scalar kernel has "
+              << test::describe(want.events[k]);
+      }
     }
   }
 }

@@ -213,7 +213,7 @@ void bind_tables(const Api& gl, GLuint tables) {
 
 KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& tables,
                              const kernel::ShaderVariant& variant)
-    : gl_(gl), trace_(variant.trace) {
+    : gl_(gl), trace_(variant.trace), shared_(variant.trace && kernel::shared_trace(tables)) {
   program_ = link_program(gl, kernel::kFullScreenVertexShader,
                           kernel::scene_fragment_shader(tables, variant));
   polygon_ = gl.GetUniformLocation(program_, "u_polygon");
@@ -226,7 +226,10 @@ KernelProgram::KernelProgram(const Api& gl, const kernel::SceneTables<float>& ta
   rows_ = gl.GetUniformLocation(program_, "u_rows");
   gl.GenVertexArrays(1, &vertex_array_);  // the core profile draws only with one bound
   if (trace_) gl.GenBuffers(1, &events_);
-  tables_ = make_table_buffer(gl, tables);
+  if (shared_)
+    gl.GenBuffers(1, &tables_);  // filled by each trace
+  else
+    tables_ = make_table_buffer(gl, tables);
 }
 
 KernelProgram::~KernelProgram() {
@@ -255,9 +258,16 @@ void KernelProgram::draw(const CameraBasis<float>& c, int polygon, glm::vec3 fro
   gl_.DrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-Trace KernelProgram::trace(const Ray& ray, int max_events) const {
+Trace KernelProgram::trace(const Ray& ray, int max_events,
+                           const kernel::SceneTables<float>& tables) const {
   if (!trace_) throw std::logic_error("KernelProgram::trace needs a trace program");
   max_events = std::max(max_events, 0);
+  if (shared_) {
+    const std::string bytes = kernel::table_buffer(tables, true);
+    gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, tables_);
+    gl_.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(bytes.size()), bytes.data(),
+                   GL_STREAM_DRAW);
+  }
   const size_t bytes = shader_trace_bytes(max_events);
   const ShaderEventHeader header{0, max_events, 0, 0};
   // (Binding the tables binds their buffer to the generic binding point too: before the events'.)

@@ -119,14 +119,15 @@ class KernelProgram {
   double seconds_per_pixel() const { return seconds_per_pixel_; }
   void set_seconds_per_pixel(double s) const { seconds_per_pixel_ = s; }
 
-  // Marches one ray in a 1 x 1 viewport of the bound framebuffer (a trace program only).
-  Trace trace(const Ray& ray, int max_events) const;
+  // Marches one ray of `tables`' scene in a 1 x 1 viewport of the bound framebuffer (a trace
+  // program only; one shared by scenes loads their tables into its buffer first).
+  Trace trace(const Ray& ray, int max_events, const kernel::SceneTables<float>& tables) const;
 
  private:
   const Api& gl_;
-  bool trace_;
+  bool trace_, shared_ = false;  // a trace program shared by scenes (kernel::shared_trace)
   GLuint program_ = 0, vertex_array_ = 0, events_ = 0;
-  GLuint tables_ = 0;  // the scene's table buffer, where its shader reads one
+  GLuint tables_ = 0;  // the scene's table buffer, where its shader reads one; a shared trace's
   GLint polygon_ = -1, from_ = -1, forward_ = -1, right_ = -1, up_ = -1, scale_ = -1, size_ = -1,
         rows_ = -1;
   mutable double seconds_per_pixel_ = 0.0;

@@ -41,10 +41,14 @@ struct OpenGlBackend::Context {
 
   const gl::Api& gl() const { return gl_context->api(); }
 
+  // A program by its source and the tables it owns; a trace shared by scenes owns none (its
+  // tables come with each trace: kernel::shared_trace).
   gl::KernelProgram& program(const kernel::SceneTables<float>& tables,
                              const kernel::ShaderVariant& variant) {
+    const bool shared = variant.trace && kernel::shared_trace(tables);
     return *programs.get(
-        kernel::scene_fragment_shader(tables, variant) + kernel::table_buffer(tables),
+        kernel::scene_fragment_shader(tables, variant) +
+            (shared ? std::string() : kernel::table_buffer(tables)),
         [&] { return std::make_unique<gl::KernelProgram>(gl(), tables, variant); });
   }
 
@@ -349,7 +353,7 @@ Trace OpenGlBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   gl::KernelProgram& program = c.program(tables, {.trace = true, .shape = c.shape});
   c.targets.reset();  // bound while it lives; a trace draws to one pixel
   const gl::RenderTargets targets(gl, 1, 1);
-  Trace trace = program.trace(ray, max_events);
+  Trace trace = program.trace(ray, max_events, tables);
   if (const std::string e = gl::errors(gl); !e.empty())
     throw std::runtime_error("the opengl backend failed to trace: " + e);
   return trace;

@@ -276,8 +276,9 @@ struct VulkanBackend::Context {
 
   // The scene's tables, where its shader reads them from the table buffer; read by the device
   // from host-visible memory (device-local too where there is such memory).
-  void load_tables(const kernel::SceneTables<float>& scene) {
-    const std::string bytes = kernel::table_buffer(scene);
+  // The table buffer a frame's program reads, or a trace's (kernel::table_buffer).
+  void load_tables(const kernel::SceneTables<float>& scene, bool trace = false) {
+    const std::string bytes = kernel::table_buffer(scene, trace);
     if (bytes.empty()) return;
     reserve_tables(bytes.size());
     std::memcpy(table_buffer.mapped, bytes.data(), bytes.size());
@@ -764,7 +765,7 @@ Trace VulkanBackend::trace(const Scene& scene, const Ray& ray, const MarchParams
   const vk::Pipeline pipeline = *c.pipeline(tables, {.trace = true, .shape = c.shape}).pipeline;
   const size_t bytes = shader_trace_bytes(max_events);
   c.reserve_events(bytes);
-  c.load_tables(tables);
+  c.load_tables(tables, /*trace=*/true);
   const ShaderEventHeader header{0, max_events, 0, 0};
   std::memcpy(c.events.mapped, &header, sizeof header);
   const kernel::ComputeConstants constants{.from = glm::vec4(glm::vec3(ray.from), 0.0f),

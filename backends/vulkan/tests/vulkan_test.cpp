@@ -20,6 +20,7 @@
 #include "backends/vulkan/tests/vulkan_backend.hpp"
 #include "kernels/scene_shader.hpp"
 #include "kernels/shader_log.hpp"
+#include "scene/surfaces.hpp"
 #include "tests/gallery.hpp"
 #include "tests/gpu_backend_checks.hpp"
 #include "tests/oracle_compare.hpp"
@@ -151,15 +152,13 @@ TEST(VulkanShader, ReadsTheTablesOfSeveralRoomsFromTheTableBuffer) {
   const Scene& scene = test::gallery_scene("cube");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
   ASSERT_TRUE(kernel::tables_in_buffer(tables));
-  for (bool trace : {false, true}) {
-    const std::string source = kernel::scene_compute_shader(tables, {.trace = trace});
-    EXPECT_NE(source.find("layout(std430, binding = 6) readonly buffer SceneTableBuffer {\n"
-                          "  ivec4 polygons[6];\n  EdgeRecord edges[24];\n"
-                          "  ObjectRecord objects[1];\n};"),
-              std::string::npos);
-    EXPECT_EQ(source.find("EdgeRecord edges[24] ="), std::string::npos) << "not baked in too";
-    EXPECT_NE(source.find("const KernelParams params"), std::string::npos) << "still baked in";
-  }
+  const std::string source = kernel::scene_compute_shader(tables);
+  EXPECT_NE(source.find("layout(std430, binding = 6) readonly buffer SceneTableBuffer {\n"
+                        "  ivec4 polygons[6];\n  EdgeRecord edges[24];\n"
+                        "  ObjectRecord objects[1];\n};"),
+            std::string::npos);
+  EXPECT_EQ(source.find("EdgeRecord edges[24] ="), std::string::npos) << "not baked in too";
+  EXPECT_NE(source.find("const KernelParams params"), std::string::npos) << "still baked in";
   // The buffer as std430 lays it out: six squares of four edges each, then their 24 edges
   // (112 bytes each), then the one solid (64 bytes).
   const std::string bytes = kernel::table_buffer(tables);
@@ -189,6 +188,66 @@ TEST(VulkanShader, ReadsTheTablesOfSeveralRoomsFromTheTableBuffer) {
   // A scene of one room bakes them in and has no buffer.
   EXPECT_TRUE(
       kernel::table_buffer(kernel::compile_scene<float>(test::gallery_scene("torus"), {})).empty());
+}
+
+// A trace is one program for every scene and method (kernel::shared_trace): its tables,
+// parameters and features come in the table buffer, laid out as the shader declares them.
+TEST(VulkanShader, ATraceIsOneProgramForEveryScene) {
+  const Scene& cube = test::gallery_scene("cube");
+  MarchParams analytic;
+  analytic.method = Method::analytic;
+  analytic.eps = 1e-3;
+  const kernel::SceneTables<float> tables = kernel::compile_scene<float>(cube, analytic);
+  const std::string source = kernel::scene_compute_shader(tables, {.trace = true});
+  for (const char* name : {"torus", "l_shape", "mirror_double_pentagon", "double_pentagon_prism"})
+    for (const Method m : kKernelMethods) {
+      MarchParams params;
+      params.method = m;
+      const kernel::SceneTables<float> other =
+          kernel::compile_scene<float>(test::gallery_scene(name), params);
+      ASSERT_TRUE(kernel::shared_trace(other)) << name;
+      EXPECT_EQ(kernel::scene_compute_shader(other, {.trace = true}), source)
+          << name << " " << to_string(m);
+      EXPECT_EQ(kernel::scene_fragment_shader(other, {.trace = true}),
+                kernel::scene_fragment_shader(tables, {.trace = true}))
+          << name << " " << to_string(m);
+    }
+  EXPECT_EQ(source.find("const KernelParams params"), std::string::npos) << "nothing baked in";
+  EXPECT_EQ(source.find("const uint FEATURES"), std::string::npos);
+  EXPECT_NE(source.find("#define FEATURES (trace_scene.x)"), std::string::npos);
+  EXPECT_FALSE(vulkan::compile_compute(source).empty());
+
+  // The buffer: the parameters (192 bytes), the features, 256 polygons, 64 objects, the edges.
+  const std::string bytes = kernel::table_buffer(tables, true);
+  const size_t objects = 192 + 16 + kernel::kTracePolygons * 16,
+               edges = objects + kernel::kTraceObjects * 64;
+  ASSERT_EQ(bytes.size(), edges + 24u * 112);
+  const auto int_at = [&](size_t offset) {
+    int32_t v;
+    std::memcpy(&v, bytes.data() + offset, sizeof v);
+    return v;
+  };
+  const auto float_at = [&](size_t offset) {
+    float v;
+    std::memcpy(&v, bytes.data() + offset, sizeof v);
+    return v;
+  };
+  EXPECT_EQ(int_at(0), kMethodAnalytic);
+  EXPECT_EQ(int_at(8), 6) << "polygon_count";
+  EXPECT_EQ(float_at(16), 1e-3f) << "eps";
+  EXPECT_EQ(static_cast<uint>(int_at(192)), tables.features);
+  EXPECT_EQ(int_at(208 + 5 * 16), 20) << "the sixth face's first edge";
+  EXPECT_EQ(int_at(208 + 6 * 16 + 4), 0) << "past the faces: zeros";
+  EXPECT_EQ(float_at(objects + 0), 1.0f) << "the solid's centre (1, 1, 1)";
+  EXPECT_EQ(float_at(edges + 8), 2.0f) << "the first edge from (0, 0) to (2, 0)";
+
+  // A scene of more rooms than the shared trace holds traces with a program of its own.
+  const kernel::SceneTables<float> stairs =
+      kernel::compile_scene<float>(staircase_surface(2 * kernel::kTracePolygons), {});
+  EXPECT_FALSE(kernel::shared_trace(stairs));
+  EXPECT_NE(kernel::scene_compute_shader(stairs, {.trace = true}).find("SceneTableBuffer"),
+            std::string::npos);
+  EXPECT_EQ(kernel::table_buffer(stairs, true), kernel::table_buffer(stairs));
 }
 
 TEST(VulkanShader, RowsOfWorkgroupsDrawEveryRowOnceInASpreadOrder) {
