@@ -6,6 +6,8 @@
 #include <random>
 #include <sstream>
 
+#include <tbb/parallel_for.h>
+
 #include "backends/scalar/scalar.hpp"
 #include "conformance/external.hpp"
 #include "conformance/vocabulary.hpp"
@@ -239,16 +241,44 @@ const FrameTruth& Suite::truth(const Scene& scene, const MarchParams& params, in
   return it->second;
 }
 
-const Frame& Suite::reference(const Scene& scene, const MarchParams& params, int width,
-                              int height) {
+namespace {
+
+// The parameters of a case's steps reference: its own in float64.
+MarchParams reference_params(const MarchParams& params) {
   MarchParams p = params;
   p.precision = Precision::f64;
+  return p;
+}
+
+}  // namespace
+
+const Frame& Suite::reference(const Scene& scene, const MarchParams& params, int width,
+                              int height) {
+  const MarchParams p = reference_params(params);
   const std::string k = key(scene, p, width, height, true);
   auto it = references_.find(k);
   if (it == references_.end())
     it = references_.emplace(k, ScalarBackend().render(scene, scene.camera, width, height, p, {}))
              .first;
   return it->second;
+}
+
+void Suite::prepare_references(const Scene& scene, const std::vector<MarchParams>& params,
+                               int width, int height) {
+  std::vector<std::pair<std::string, MarchParams>> missing;
+  for (const MarchParams& each : params) {
+    const MarchParams p = reference_params(each);
+    std::string k = key(scene, p, width, height, true);
+    if (!references_.count(k) &&
+        std::none_of(missing.begin(), missing.end(), [&](const auto& m) { return m.first == k; }))
+      missing.emplace_back(std::move(k), p);
+  }
+  std::vector<Frame> frames(missing.size());
+  tbb::parallel_for(size_t{0}, missing.size(), [&](size_t i) {
+    frames[i] = ScalarBackend().render(scene, scene.camera, width, height, missing[i].second, {});
+  });
+  for (size_t i = 0; i < missing.size(); ++i)
+    references_.emplace(std::move(missing[i].first), std::move(frames[i]));
 }
 
 const std::vector<std::pair<Ray, Trace>>& Suite::probes(const Scene& scene, int count, int events,

@@ -108,6 +108,13 @@ class Suite {
   // over eps and offset then measures each point against one truth, and a large eps cannot
   // widen the mask over the pixels it gets wrong.
   void fix_mask(const MarchParams& mask) { mask_ = mask; }
+  // Draws the steps references (the scalar backend in float64, one thread each) of the cases
+  // run() will be given with these parameters at this size, all cores at once: a sweep's points
+  // are half their time in them on one core otherwise. The same frames run() would draw.
+  void prepare_references(const Scene& scene, const std::vector<MarchParams>& params, int width,
+                          int height);
+  // How many steps references it holds.
+  size_t references() const { return references_.size(); }
   // Keeps each case's pixel classes (CaseResult::pixel_classes) for an error image.
   void keep_pixel_classes(bool keep) { keep_classes_ = keep; }
   // The oracle's frame a case was judged against (run() computes it first).

@@ -138,16 +138,25 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
   for (const Scene& scene : scenes)
     for (Method m : o.methods) {
       if (!held(scene, m)) continue;
+      const auto point_params = [&](Precision p, double eps, size_t k) {
+        MarchParams params = o.params;
+        params.method = m;
+        params.precision = p;
+        params.eps = eps;
+        params.offset = k < o.offset_factors.size() ? o.offset_factors[k] * eps
+                                                    : o.offset_fixed[k - o.offset_factors.size()];
+        return params;
+      };
+      // The points' steps references first, on every core (nothing is timed meanwhile).
+      std::vector<MarchParams> all;
+      for (Precision p : precisions)
+        for (double eps : o.eps)
+          for (size_t k = 0; k < labels.size(); ++k) all.push_back(point_params(p, eps, k));
+      suite.prepare_references(scene, all, o.width, o.height);
       for (Precision p : precisions)
         for (double eps : o.eps)
           for (size_t k = 0; k < labels.size(); ++k) {
-            MarchParams params = o.params;
-            params.method = m;
-            params.precision = p;
-            params.eps = eps;
-            params.offset = k < o.offset_factors.size()
-                                ? o.offset_factors[k] * eps
-                                : o.offset_fixed[k - o.offset_factors.size()];
+            const MarchParams params = point_params(p, eps, k);
             json point = {{"scene", scene.name},
                           {"surface_type", surface_type(scene)},
                           {"method", to_string(m)},

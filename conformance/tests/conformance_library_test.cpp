@@ -137,6 +137,29 @@ TEST(Regions, AsTheirDefinitionSaysPixelByPixel) {
   EXPECT_GT(failed, 0u);  // the pushed colours fail somewhere
 }
 
+// The steps references drawn ahead on every core are the ones run() then uses (it draws none),
+// and the case's figures are those of a suite that drew its own.
+TEST(Suite, ReferencesPreparedAheadAreTheOnesACaseUses) {
+  const Scene scene = torus();
+  MarchParams a, b;
+  a.method = b.method = Method::sphere;
+  b.eps = 1e-3;
+  b.offset = 2e-3;
+  Suite prepared;
+  prepared.prepare_references(scene, {a, b, a}, 48, 27);
+  EXPECT_EQ(prepared.references(), 2u);
+  for (const MarchParams& p : {a, b}) {
+    const CaseResult got = prepared.run(ScalarBackend(), scene, p, 48, 27);
+    Suite own;
+    const CaseResult want = own.run(ScalarBackend(), scene, p, 48, 27);
+    EXPECT_EQ(got.reference_steps.mean, want.reference_steps.mean);
+    EXPECT_EQ(got.reference_steps.p99, want.reference_steps.p99);
+    EXPECT_EQ(got.steps_ks, want.steps_ks);
+    EXPECT_EQ(own.references(), 1u);
+  }
+  EXPECT_EQ(prepared.references(), 2u) << "run() drew a reference of its own";
+}
+
 TEST(Traces, PositionErrorDivergenceAndLeak) {
   const Scene scene = torus();
   Trace truth;
