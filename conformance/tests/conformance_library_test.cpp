@@ -61,6 +61,13 @@ Scene torus(const std::string& extra = "") {
   return parse_scene(test::torus_json(extra), "torus.json");
 }
 
+// The torus with a sphere of `radius` at (2, 2, 1), seen from (0.5, 0.7, 1).
+Scene torus_with_sphere(double radius) {
+  return torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1], "radius": )" +
+               std::to_string(radius) +
+               R"(}], "camera": {"position": [0.5, 0.7, 1], "yaw_deg": 20})");
+}
+
 Event gluing(int edge, Vec3 at, double t) {
   Event e;
   e.kind = EventKind::gluing;
@@ -77,9 +84,7 @@ Event gluing(int edge, Vec3 at, double t) {
 // regions it finds, their compared and failed pixels and their worst difference, on a frame of
 // the scalar backend with a few pixels' colours pushed away and a few hits changed.
 TEST(Regions, AsTheirDefinitionSaysPixelByPixel) {
-  const Scene scene = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
-                                            "radius": 0.4}], "camera": {"position": [0.5, 0.7, 1],
-                                            "yaw_deg": 20})");
+  const Scene scene = torus_with_sphere(0.4);
   MarchParams params;
   params.method = Method::analytic;
   const int w = 48, h = 27;
@@ -353,9 +358,7 @@ bool failed(const CaseResult& r, const std::string& check) {
 }
 
 TEST(Suite, TheScalarBackendPassesAndEachFlawIsCaughtByItsCheck) {
-  const Scene scene = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
-                                            "radius": 0.5}], "camera": {"position": [0.5, 0.7, 1],
-                                            "yaw_deg": 20})");
+  const Scene scene = torus_with_sphere(0.5);
   MarchParams params;
   params.method = Method::analytic;
   Suite suite;
@@ -379,9 +382,7 @@ TEST(Suite, TheScalarBackendPassesAndEachFlawIsCaughtByItsCheck) {
 
   // A wrongly shaded object, a few percent of the frame, passes the whole frame's colour checks
   // (idiff and Yee's metric count over every pixel) and fails its own region's (issue 22).
-  const Scene small = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
-                                            "radius": 0.18}], "camera": {"position": [0.5, 0.7, 1],
-                                            "yaw_deg": 20})");
+  const Scene small = torus_with_sphere(0.18);
   for (const Broken::Flaw f : {Broken::Flaw::flat_object, Broken::Flaw::swapped_normal}) {
     const CaseResult shaded = suite.run(Broken(f), small, params, 96, 54);
     for (const RegionColour& r : shaded.regions)
@@ -410,9 +411,7 @@ TEST(Suite, TheScalarBackendPassesAndEachFlawIsCaughtByItsCheck) {
 // The suite's words (vocabulary.hpp): every check a case has, every failure class and every
 // verdict the code can give is one of them, with a meaning.
 TEST(Vocabulary, NamesEveryCheckFailureClassAndVerdict) {
-  const Scene scene = torus(R"("objects": [{"type": "sphere", "polygon": 0, "center": [2, 2, 1],
-                                            "radius": 0.5}], "camera": {"position": [0.5, 0.7, 1],
-                                            "yaw_deg": 20})");
+  const Scene scene = torus_with_sphere(0.5);
   Suite suite;
   const CaseResult r =
       suite.run(Broken(Broken::Flaw::phantom_object), scene, MarchParams{}, 32, 18);

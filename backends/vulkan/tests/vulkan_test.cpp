@@ -148,6 +148,14 @@ TEST(VulkanSpirvCache, KeepsTheNewestModulesPastItsBound) {
   EXPECT_TRUE(std::filesystem::exists(folder / "notes.txt"));
 }
 
+// The number of type T at `offset` in a table buffer's bytes.
+template <typename T>
+T number_at(const std::string& bytes, size_t offset) {
+  T v;
+  std::memcpy(&v, bytes.data() + offset, sizeof v);
+  return v;
+}
+
 TEST(VulkanShader, ReadsTheTablesOfSeveralRoomsFromTheTableBuffer) {
   const Scene& scene = test::gallery_scene("cube");
   const kernel::SceneTables<float> tables = kernel::compile_scene<float>(scene, {});
@@ -163,16 +171,8 @@ TEST(VulkanShader, ReadsTheTablesOfSeveralRoomsFromTheTableBuffer) {
   // (112 bytes each), then the one solid (64 bytes).
   const std::string bytes = kernel::table_buffer(tables);
   ASSERT_EQ(bytes.size(), 6u * 16 + 24u * 112 + 64);
-  const auto int_at = [&](size_t offset) {
-    int32_t v;
-    std::memcpy(&v, bytes.data() + offset, sizeof v);
-    return v;
-  };
-  const auto float_at = [&](size_t offset) {
-    float v;
-    std::memcpy(&v, bytes.data() + offset, sizeof v);
-    return v;
-  };
+  const auto int_at = [&](size_t offset) { return number_at<int32_t>(bytes, offset); };
+  const auto float_at = [&](size_t offset) { return number_at<float>(bytes, offset); };
   for (int p = 0; p < 6; ++p) {
     EXPECT_EQ(int_at(16 * static_cast<size_t>(p)), 4 * p) << "first edge of polygon " << p;
     EXPECT_EQ(int_at(16 * static_cast<size_t>(p) + 4), 4) << "edges of polygon " << p;
@@ -226,16 +226,8 @@ TEST(VulkanShader, ATraceIsOneProgramForEveryScene) {
   const size_t objects = 192 + 16 + kernel::kTracePolygons * 16,
                edges = objects + kernel::kTraceObjects * 64;
   ASSERT_EQ(bytes.size(), edges + 24u * 112);
-  const auto int_at = [&](size_t offset) {
-    int32_t v;
-    std::memcpy(&v, bytes.data() + offset, sizeof v);
-    return v;
-  };
-  const auto float_at = [&](size_t offset) {
-    float v;
-    std::memcpy(&v, bytes.data() + offset, sizeof v);
-    return v;
-  };
+  const auto int_at = [&](size_t offset) { return number_at<int32_t>(bytes, offset); };
+  const auto float_at = [&](size_t offset) { return number_at<float>(bytes, offset); };
   EXPECT_EQ(int_at(0), kMethodAnalytic);
   EXPECT_EQ(int_at(8), 6) << "polygon_count";
   EXPECT_EQ(float_at(16), 1e-3f) << "eps";
