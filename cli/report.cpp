@@ -506,7 +506,7 @@ void add_report(CLI::App& app) {
     const char* no_cache = std::getenv("MESA_SHADER_CACHE_DISABLE");
     if (jobs > 0 && o->supervision.isolate == "worker" && !o->supervision.resume &&
         !(no_cache && (std::string(no_cache) == "true" || std::string(no_cache) == "1")))
-      compiled = reports::compile_cases(order, scenes, compiling);
+      compiled = reports::compile_cases(order, scenes, compiling, r.matrix.methods);
     // The dearest first: the last to finish are the cheap ones, and the cores finish together.
     std::stable_sort(compiled.begin(), compiled.end(),
                      [](const auto& a, const auto& b) { return a.second > b.second; });

@@ -66,9 +66,11 @@ std::optional<CaseKey> parse_case_key(const std::string& key);
 // The compile cases of `cases` (matrix cases among others, by key) whose backend is one of
 // `backends`: "compile/BACKEND/METHOD/SCENE", each with its expected seconds on one thread (more
 // rooms, more code), in the order of `cases`.
+// A backend's trace program that scenes share (kernel::shared_trace) is compiled by one case, the
+// first scene's that shares it with the first of `methods`, the dearer by its compile.
 std::vector<std::pair<std::string, double>> compile_cases(
     const std::vector<std::pair<std::string, double>>& cases, const std::vector<Scene>& scenes,
-    const std::vector<std::string>& backends);
+    const std::vector<std::string>& backends, const std::vector<Method>& methods);
 // Compiles a compile case's programs on its backend, one of `backends` (a worker's matrix
 // backends). Returns {"seconds"}; throws std::invalid_argument for a key that names no scene,
 // method or backend here.
