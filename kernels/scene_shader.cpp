@@ -260,7 +260,7 @@ bool shared_trace(const SceneTables<float>& tables) {
 
 std::string table_buffer(const SceneTables<float>& tables, bool trace) {
   std::string bytes;
-  if (trace && shared_trace(tables)) {  // as kSharedTraceTables declares them
+  if (trace && shared_trace(tables)) {  // as shared_trace_tables() declares them
     static_assert(std::is_trivially_copyable_v<Tables<float>::KernelParams>);
     bytes.append(reinterpret_cast<const char*>(&tables.params), sizeof tables.params);
     const std::array<uint, 4> scene{tables.features, 0u, 0u, 0u};
@@ -302,7 +302,7 @@ std::string shared_trace_tables() {
 // A shared trace's variant: the gpu shape whatever the backend's (its loops test first, and it
 // picks no edge from constants), since what the software shape saves is in the frames of a
 // software rasteriser, not in one ray; on llvmpipe and lavapipe it compiled in a quarter of the
-// time (2-vCPU Intel Xeon, caches empty: Vulkan 5.8 -> 1.45 s, OpenGL 2.8 -> 0.7 s).
+// time (2-vCPU Intel Xeon, caches empty: Vulkan 5.8 -> 1.0-1.5 s, OpenGL 2.8 -> 0.7 s).
 ShaderVariant shared_trace_variant(const ShaderVariant& v) {
   ShaderVariant shared = v;
   shared.shape = KernelShape::gpu;

@@ -373,10 +373,12 @@ std::vector<std::pair<std::string, double>> compile_cases(
       continue;
     const auto scene = by_name.find(k->scene);
     if (scene == by_name.end()) continue;
-    // A case's programs on llvmpipe and lavapipe (OpenGL three, Vulkan two), two cases at once,
-    // cache empty (a 2-vCPU Intel Xeon, AVX-512, LLVM 15 at 256 bits): a median 0.40 s in a
-    // scene of one room, 0.49 s in one of several, whose tables the kernel reads from a buffer
-    // (kernels/scene_shader.hpp's tables_in_buffer; baked in, the cube's took 38 s).
+    // A case's programs on llvmpipe and lavapipe when they were three on OpenGL and two on
+    // Vulkan, a trace program among them, two cases at once, cache empty (a 2-vCPU Intel Xeon,
+    // AVX-512, LLVM 15 at 256 bits): a median 0.40 s in a scene of one room, 0.49 s in one of
+    // several, whose tables the kernel reads from a buffer (kernels/scene_shader.hpp's
+    // tables_in_buffer; baked in, the cube's took 38 s). Its trace now shared, a case compiles
+    // one program fewer; the run's calibration (estimate.hpp) takes the difference.
     const bool rooms = scene->second->polygons.size() > 1;
     const bool traces = k->scene + "/" + k->method == shared;
     out.emplace_back("compile/" + conformance::case_key(k->backend, k->method, k->scene),
