@@ -138,56 +138,57 @@ json run_sweep(const std::vector<Scene>& scenes, const SweepOptions& o, conforma
   for (const Scene& scene : scenes)
     for (Method m : o.methods) {
       if (!held(scene, m)) continue;
-      const auto point_params = [&](Precision p, double eps, size_t k) {
-        MarchParams params = o.params;
-        params.method = m;
-        params.precision = p;
-        params.eps = eps;
-        params.offset = k < o.offset_factors.size() ? o.offset_factors[k] * eps
-                                                    : o.offset_fixed[k - o.offset_factors.size()];
-        return params;
-      };
-      // The points' steps references first, on every core (nothing is timed meanwhile).
-      std::vector<MarchParams> all;
-      for (Precision p : precisions)
-        for (double eps : o.eps)
-          for (size_t k = 0; k < labels.size(); ++k) all.push_back(point_params(p, eps, k));
-      suite.prepare_references(scene, all, o.width, o.height);
+      // The grid's points (precision, eps, offset, in that order), their steps references
+      // drawn first on every core (nothing is timed meanwhile), then each measured and timed.
+      std::vector<MarchParams> grid;
       for (Precision p : precisions)
         for (double eps : o.eps)
           for (size_t k = 0; k < labels.size(); ++k) {
-            const MarchParams params = point_params(p, eps, k);
-            json point = {{"scene", scene.name},
-                          {"surface_type", surface_type(scene)},
-                          {"method", to_string(m)},
-                          {"precision", precision_name(p)},
-                          {"eps", eps},
-                          {"offset", params.offset},
-                          {"offset_label", labels[k]}};
-            try {
-              const conformance::CaseResult r =
-                  suite.run(*backend, scene, params, o.width, o.height);
-              std::vector<double> ms = {1e3 * r.seconds};
-              for (int rep = 1; rep < o.repetitions; ++rep) {
-                const auto start = std::chrono::steady_clock::now();
-                backend->render(scene, scene.camera, o.width, o.height, params, {});
-                ms.push_back(std::chrono::duration<double, std::milli>(
-                                 std::chrono::steady_clock::now() - start)
-                                 .count());
-              }
-              point["time_ms"] = median(ms);
-              point["steps_mean"] = r.steps.mean;
-              point["steps_p99"] = r.steps.p99;
-              point["accuracy"] = accuracy_summary(r);
-            } catch (const std::exception& e) {
-              point["error"] = e.what();
-            }
-            points.push_back(std::move(point));
-            if (progress)
-              progress(scene.name + " " + to_string(m) + " " + precision_name(p) +
-                           " eps=" + number(eps) + " offset=" + labels[k],
-                       ++done, total);
+            MarchParams params = o.params;
+            params.method = m;
+            params.precision = p;
+            params.eps = eps;
+            params.offset = k < o.offset_factors.size()
+                                ? o.offset_factors[k] * eps
+                                : o.offset_fixed[k - o.offset_factors.size()];
+            grid.push_back(params);
           }
+      suite.prepare_references(scene, grid, o.width, o.height);
+      for (size_t i = 0; i < grid.size(); ++i) {
+        const MarchParams& params = grid[i];
+        const Precision p = params.precision;
+        const double eps = params.eps;
+        const size_t k = i % labels.size();
+        json point = {{"scene", scene.name},
+                      {"surface_type", surface_type(scene)},
+                      {"method", to_string(m)},
+                      {"precision", precision_name(p)},
+                      {"eps", eps},
+                      {"offset", params.offset},
+                      {"offset_label", labels[k]}};
+        try {
+          const conformance::CaseResult r = suite.run(*backend, scene, params, o.width, o.height);
+          std::vector<double> ms = {1e3 * r.seconds};
+          for (int rep = 1; rep < o.repetitions; ++rep) {
+            const auto start = std::chrono::steady_clock::now();
+            backend->render(scene, scene.camera, o.width, o.height, params, {});
+            ms.push_back(
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count());
+          }
+          point["time_ms"] = median(ms);
+          point["steps_mean"] = r.steps.mean;
+          point["steps_p99"] = r.steps.p99;
+          point["accuracy"] = accuracy_summary(r);
+        } catch (const std::exception& e) {
+          point["error"] = e.what();
+        }
+        points.push_back(std::move(point));
+        if (progress)
+          progress(scene.name + " " + to_string(m) + " " + precision_name(p) +
+                       " eps=" + number(eps) + " offset=" + labels[k],
+                   ++done, total);
+      }
     }
   // Each recommended point again at confirm_scale times the frame size, on every scene of its
   // type: a point that passed only because the small frames missed a few failing rays drops
@@ -319,9 +320,9 @@ json analyse_sweep(const json& points, const json& confirmations) {
              (!confirmation || (*confirmation)["passed"].get<bool>());
     }
     // What made the cell unstable, in one word: the failure class whose threshold the most
-    // scenes fail (ties: the most rays of it); else, when the hit, crossings or trace agreement
-    // fails (which the classes' rays make up), the class with the most rays; else the check the
-    // most scenes fail; else an error or a failed re-check; "" when stable.
+    // scenes fail (ties: the most rays of it); else, when the hit, crossings or trace
+    // agreement fails (which the classes' rays make up), the class with the most rays; else
+    // the check the most scenes fail; else an error or a failed re-check; "" when stable.
     std::string cause() const {
       std::string best;
       std::tuple<bool, int, long> best_key{false, 0, 0};
@@ -444,10 +445,11 @@ json analyse_sweep(const json& points, const json& confirmations) {
                           {"time_ms", c->time_ms},
                           {"hit_mismatch", c->hit_mismatch}});
       }
-    // Recommended: of the stable points whose eps neighbours (a decade either side, same offset
-    // rule) are stable too, so that neither rounding nor a neighbouring choice tips them (failing
-    // that, of all stable points), those within 10% of the fewest mean steps, and of these the
-    // one with the most stable neighbours on the grid, then the one nearest the defaults.
+    // Recommended: of the stable points whose eps neighbours (a decade either side, same
+    // offset rule) are stable too, so that neither rounding nor a neighbouring choice tips
+    // them (failing that, of all stable points), those within 10% of the fewest mean steps,
+    // and of these the one with the most stable neighbours on the grid, then the one nearest
+    // the defaults.
     std::sort(g.eps.begin(), g.eps.end());
     // g named in the capture: Clang 14 cannot capture a structured binding.
     const auto stable_at = [&g = g](long e, long k) {
@@ -462,8 +464,9 @@ json analyse_sweep(const json& points, const json& confirmations) {
       const Cell* cell;
       bool interior;
       int margin;  // stable neighbours of the 8 around it
-      // |log10(eps / 1e-4)| + |log10(offset / 2e-4)|: among equals, the defaults' neighbourhood
-      // (the analytic method, which pushes no point across an edge, ignores the offset).
+      // |log10(eps / 1e-4)| + |log10(offset / 2e-4)|: among equals, the defaults'
+      // neighbourhood (the analytic method, which pushes no point across an edge, ignores the
+      // offset).
       double from_default;
     };
     std::vector<Candidate> candidates;
@@ -506,8 +509,8 @@ json analyse_sweep(const json& points, const json& confirmations) {
                     {"offset_label", pick->label},
                     {"time_ms", pick->time_ms},
                     {"hit_mismatch", pick->hit_mismatch},
-                    // No stable point has stable eps neighbours: the pick may sit on an edge of
-                    // the stable region.
+                    // No stable point has stable eps neighbours: the pick may sit on an edge
+                    // of the stable region.
                     {"fallback", !interior},
                     {"confirmed", pick->confirmation ? *pick->confirmation : json(nullptr)},
                     {"why", std::string(interior ? "of the stable points whose neighbours a "

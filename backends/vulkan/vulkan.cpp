@@ -274,9 +274,9 @@ struct VulkanBackend::Context {
     write_descriptors();
   }
 
-  // The scene's tables, where its shader reads them from the table buffer; read by the device
-  // from host-visible memory (device-local too where there is such memory).
-  // The table buffer a frame's program reads, or a trace's (kernel::table_buffer).
+  // The scene's tables where its frame's program, or its trace's, reads them from the table
+  // buffer (kernel::table_buffer); read by the device from host-visible memory (device-local too
+  // where there is such memory).
   void load_tables(const kernel::SceneTables<float>& scene, bool trace = false) {
     const std::string bytes = kernel::table_buffer(scene, trace);
     if (bytes.empty()) return;
