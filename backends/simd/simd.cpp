@@ -244,7 +244,6 @@ std::optional<LaneFigures> SimdBackend::lane_figures(const Scene& scene, const C
   options.isa = isa();
   options.threads = 1;
   const SimdBackend one(options);
-  one.render_colour(scene, camera, width, height, params, {});
   std::array<double, 3> seconds{};
   for (double& s : seconds) {
     const auto start = std::chrono::steady_clock::now();
