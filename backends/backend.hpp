@@ -164,6 +164,10 @@ class Backend {
   // SwiftShader's threads after the case, slowing the next cases of the other backends). The
   // next frame opens what it needs again.
   virtual void rest() const {}
+  // Whether its cases are best run one after another, resting only when another backend's case
+  // comes: what rest() lets go of is dear to start again (webgl: its browser, a second or more a
+  // case on a 2-core machine).
+  virtual bool runs_back_to_back() const { return false; }
   // What it is where it is a renderer we did not write, called as a command; null for ours.
   virtual const ExternalInfo* external() const { return nullptr; }
   // Its lanes' figures for a case (LaneFigures; the peak timed for about `peak_seconds`); none

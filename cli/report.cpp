@@ -16,6 +16,7 @@
 #include "conformance/expectations.hpp"
 #include "conformance/suite.hpp"
 #include "output/dynamic_library.hpp"
+#include "reports/estimate.hpp"
 #include "reports/fingerprint.hpp"
 #include "reports/page.hpp"
 #include "reports/report.hpp"
@@ -420,8 +421,11 @@ void add_report(CLI::App& app) {
         reports::report_cases(scenes, r, &*backends);
     const json skipped = backends->skipped;
     std::vector<std::string> compiling;  // the backends whose kernels a case compiles
-    for (const auto& b : backends->available)
+    std::vector<std::string> together;   // those whose cases run one after another
+    for (const auto& b : backends->available) {
       if (b->compiles_per_scene()) compiling.push_back(b->name());
+      if (b->runs_back_to_back()) together.push_back(b->name());
+    }
     if (!o->supervision.worker && o->supervision.isolate != "none") backends.reset();
     std::optional<reports::ShardPlan> plan;
     if (r.shard) plan = reports::plan_shard(*r.shard, all);
@@ -435,10 +439,16 @@ void add_report(CLI::App& app) {
         return record_or_error(
             [&] { return reports::run_compile_case(key, scenes, r.matrix, backends->available); });
       return record_or_error([&]() -> json {
+        // A backend rests after each case (Backend::rest), or, where its cases run back to back,
+        // before the first case of another that follows them.
+        const reports::CaseGroups g = reports::case_groups(key);
+        for (const auto& b : backends->available)
+          if (b->runs_back_to_back() && !(g.stage == "matrix" && g.group == b->name())) b->rest();
         json part = reports::run_report_part(
             scenes, r, [&](const std::string& k) { return k == key; }, {matrix_suite, sweep_suite},
             nullptr, &*backends, /*every_stage=*/false);
-        for (const auto& b : backends->available) b->rest();
+        for (const auto& b : backends->available)
+          if (!b->runs_back_to_back()) b->rest();
         // A case this process cannot run (its backend unavailable here, not where the run was
         // planned) says so, and why, rather than coming back empty.
         const std::vector<std::string> measured = reports::report_part_keys(part);
@@ -480,12 +490,14 @@ void add_report(CLI::App& app) {
         {"size", std::to_string(r.sweep.width) + "x" + std::to_string(r.sweep.height)},
         {"repetitions", r.sweep.repetitions}};
     if (plan) run.options["shard"] = plan->record;
-    // Run so that every backend's cases are timed early (the estimates are calibrated on them);
-    // put together in the run's order all the same.
+    // Run so that every backend's cases are timed early (the estimates are calibrated on them),
+    // those of a backend that runs them back to back one after another from where its first
+    // falls; put together in the run's order all the same.
     std::vector<std::pair<std::string, double>> held;
     for (const auto& c : all)
       if (!plan || plan->holds(c.first)) held.push_back(c);
-    const std::vector<std::pair<std::string, double>> order = reports::calibrating_order(held);
+    const std::vector<std::pair<std::string, double>> order =
+        reports::back_to_back(reports::calibrating_order(held), together);
     for (const auto& [key, cost] : order) run.cases.push_back({key, cost});
     for (const json& skip : skipped)
       if (!o->quiet)

@@ -1,6 +1,7 @@
 #include "reports/estimate.hpp"
 
 #include <algorithm>
+#include <map>
 #include <stdexcept>
 
 namespace flatmarch::reports {
@@ -108,6 +109,34 @@ std::vector<std::pair<std::string, double>> calibrating_order(
     for (Case& c : interleave(spread_groups)) order.push_back(std::move(c));
   }
   return order;
+}
+
+std::vector<std::pair<std::string, double>> back_to_back(
+    const std::vector<std::pair<std::string, double>>& order,
+    const std::vector<std::string>& backends) {
+  using Case = std::pair<std::string, double>;
+  const auto together = [&](const Case& c) -> std::string {
+    const CaseGroups g = case_groups(c.first);
+    if (g.stage != "matrix" ||
+        std::find(backends.begin(), backends.end(), g.group) == backends.end())
+      return "";
+    return g.group;
+  };
+  std::map<std::string, std::vector<Case>> runs;  // each backend's cases, in their order
+  for (const Case& c : order)
+    if (const std::string b = together(c); !b.empty()) runs[b].push_back(c);
+  std::vector<Case> out;
+  out.reserve(order.size());
+  for (const Case& c : order) {
+    const std::string b = together(c);
+    if (b.empty()) {
+      out.push_back(c);
+    } else if (auto run = runs.find(b); run != runs.end()) {  // its first case: all of them
+      out.insert(out.end(), run->second.begin(), run->second.end());
+      runs.erase(run);
+    }
+  }
+  return out;
 }
 
 StageEstimate::StageEstimate(const std::vector<std::pair<std::string, double>>& cases) {

@@ -38,6 +38,13 @@ CaseGroups case_groups(const std::string& key);
 std::vector<std::pair<std::string, double>> calibrating_order(
     const std::vector<std::pair<std::string, double>>& cases);
 
+// `order` with the matrix cases of each of `backends` moved to run one after another where the
+// first of them runs, the other cases in their order: a backend whose every case would otherwise
+// start what it keeps between cases anew (webgl's browser, Backend::runs_back_to_back).
+std::vector<std::pair<std::string, double>> back_to_back(
+    const std::vector<std::pair<std::string, double>>& order,
+    const std::vector<std::string>& backends);
+
 class StageEstimate {
  public:
   // The stage's cases, (key, expected seconds), all of one stage.

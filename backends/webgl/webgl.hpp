@@ -39,6 +39,7 @@ class WebGlBackend final : public Backend {
   // the transfer through the DevTools protocol.
   std::optional<double> last_frame_seconds() const override;
   void rest() const override;
+  bool runs_back_to_back() const override { return true; }
 
  private:
   struct Session;            // the browser, its page and the temporary folder
