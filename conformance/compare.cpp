@@ -74,16 +74,55 @@ std::optional<Failure> classify(int hit, int crossings, int want, int want_cross
   return Failure::wrong_edge;  // the same end reached by another path, or another wall
 }
 
+namespace {
+
+// `got`'s colours, where `mask` is non-zero the truth's: ambiguous pixels neither pass nor fail.
+Frame masked_colours(const Frame& got, const Frame& truth, const std::vector<uint8_t>& mask,
+                     size_t* masked) {
+  Frame out;
+  out.width = got.width;
+  out.height = got.height;
+  out.rgb = got.rgb;
+  const size_t pixels = truth.rgb.size() / 3;
+  for (size_t px = 0; px < mask.size() && px < pixels; ++px)
+    if (mask[px]) {
+      if (masked) ++*masked;
+      for (size_t k = 0; k < 3; ++k) out.rgb[3 * px + k] = truth.rgb[3 * px + k];
+    }
+  return out;
+}
+
+}  // namespace
+
+PerceptualCheck::PerceptualCheck(const Frame& got, const Frame& truth,
+                                 const std::vector<uint8_t>& mask)
+    : masked_(masked_colours(got, truth, mask, nullptr)) {
+  // Yee's metric is OpenImageIO's alone: where the image module cannot be loaded it is not
+  // measured, and the case says so (CaseResult::unmeasured).
+  if (const ImageLibrary* images = image_library_if_loadable(&why_))
+    count_ = std::async(std::launch::async,
+                        [images, this, &truth] { return images->perceptual(masked_, truth); });
+}
+
+PerceptualCheck::~PerceptualCheck() {
+  if (count_.valid()) count_.wait();  // it reads masked_
+}
+
+void PerceptualCheck::finish(ImageComparison& c, const ImageThresholds& t) {
+  c.perceptual_measured = count_.valid();
+  c.perceptual_why = why_;
+  if (c.perceptual_measured) c.perceptual = count_.get();
+  const double percent = 100.0 / static_cast<double>(std::max<size_t>(c.pixels, 1));
+  c.perceptual_failed = c.perceptual_measured &&
+                        static_cast<double>(c.perceptual) * percent > t.perceptual_failpercent;
+}
+
 ImageComparison compare_images(const Frame& got, const Frame& truth,
-                               const std::vector<uint8_t>& mask, const ImageThresholds& t) {
+                               const std::vector<uint8_t>& mask, const ImageThresholds& t,
+                               bool perceptual) {
   ImageComparison c;
   c.pixels = truth.rgb.size() / 3;
-  Frame masked = got;  // ambiguous pixels take the truth's colour: they neither pass nor fail
-  for (size_t px = 0; px < mask.size() && px < c.pixels; ++px)
-    if (mask[px]) {
-      ++c.masked;
-      for (size_t k = 0; k < 3; ++k) masked.rgb[3 * px + k] = truth.rgb[3 * px + k];
-    }
+  const Frame masked = masked_colours(got, truth, mask, &c.masked);
   // idiff's figures (OpenImageIO's ImageBufAlgo::compare, as its documentation defines them): a
   // channel's difference |a - b|; a pixel warns, or fails, where one of its channels differs by
   // more than the threshold (a NaN difference too); the mean and RMS of the differences over
@@ -115,17 +154,10 @@ ImageComparison compare_images(const Frame& got, const Frame& truth,
   c.mean_error = total / values;
   c.rms_error = std::sqrt(squares / values);
   c.psnr = 20.0 * std::log10(1.0 / c.rms_error);
-  // Yee's metric is OpenImageIO's alone: where the image module cannot be loaded it is not
-  // measured, and the case says so (CaseResult::unmeasured).
-  if (const ImageLibrary* images = image_library_if_loadable(&c.perceptual_why)) {
-    c.perceptual = images->perceptual(masked, truth);
-    c.perceptual_measured = true;
-  }
   const double percent = 100.0 / static_cast<double>(std::max<size_t>(c.pixels, 1));
   c.failed = static_cast<double>(c.fail) * percent > t.failpercent || c.max_error > t.hardfail;
   c.warned = static_cast<double>(c.warn) * percent > t.warnpercent;
-  c.perceptual_failed = c.perceptual_measured &&
-                        static_cast<double>(c.perceptual) * percent > t.perceptual_failpercent;
+  if (perceptual) PerceptualCheck(got, truth, mask).finish(c, t);
   return c;
 }
 

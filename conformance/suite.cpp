@@ -373,14 +373,45 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
       unmeasured(check, external->look == "none" ? "its manifest's look is none"
                                                  : "its manifest does not list colour");
   }
-  r.image = compare_images(got, truth_colour, exact.ambiguity, t.image);
+  r.image = compare_images(got, truth_colour, exact.ambiguity, t.image, /*perceptual=*/false);
   if (colour) {
     add_check(r, "image.failpercent", 100.0 * static_cast<double>(r.image.fail) / pixels,
               t.image.failpercent, false);
     add_check(r, "image.max_error", r.image.max_error, t.image.hardfail, false);
   }
-  if (!colour) {
-  } else if (r.image.perceptual_measured)
+  // Yee's metric runs on a thread of its own while the rest is measured; the checks are added in
+  // their order once it is done.
+  std::optional<PerceptualCheck> perceptual;
+  if (colour) perceptual.emplace(got, truth_colour, exact.ambiguity);
+  std::vector<uint8_t> colour_failing;
+  r.regions = compare_regions(got, truth_colour, exact.ambiguity, t.colour,
+                              static_cast<int>(scene.objects.size()), &colour_failing);
+  if (!colour) r.regions.clear();
+  if (keep_classes_)
+    r.pixel_classes = classify_pixels(got, exact.frame, exact.ambiguity, colour_failing);
+  r.steps = step_stats(got.steps);
+
+  int diverged = 0;
+  double trace_error = 0.0;
+  if (!external) {
+    const Frame& ref = reference(scene, params, width, height);
+    r.reference_steps = step_stats(ref.steps);
+    r.steps_ks = ks_statistic(got.steps, ref.steps);
+    for (const auto& [ray, want] :
+         probes(scene, t.probe_rays, t.trace_events, params.max_distance)) {
+      const Trace trace = backend.trace(scene, ray, params, t.trace_events);
+      TraceComparison c = compare_traces(scene, trace, want, params.eps);
+      if (c.failure) {
+        ++diverged;
+        ++r.trace_failures[static_cast<size_t>(*c.failure)];
+      }
+      trace_error = std::max({trace_error, c.max_t_error, c.max_position_error});
+      r.traces.push_back(std::move(c));
+    }
+  }
+
+  if (!perceptual) {
+  } else if (perceptual->finish(r.image, t.image); r.image.perceptual_measured)
     add_check(r, "image.perceptual_failpercent",
               100.0 * static_cast<double>(r.image.perceptual) / pixels,
               t.image.perceptual_failpercent, false);
@@ -389,10 +420,6 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
   if (r.image.warned)
     r.warnings.push_back(std::to_string(r.image.warn) + " pixels differ by more than " +
                          std::to_string(t.image.warn));
-  std::vector<uint8_t> colour_failing;
-  r.regions = compare_regions(got, truth_colour, exact.ambiguity, t.colour,
-                              static_cast<int>(scene.objects.size()), &colour_failing);
-  if (!colour) r.regions.clear();
   for (const RegionColour& region : r.regions) {
     std::string name = region.name();
     std::replace(name.begin(), name.end(), ' ', '_');
@@ -400,10 +427,6 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
     add_check(r, "colour." + name, 100.0 * static_cast<double>(region.failed) / n,
               std::max(t.colour.failpercent, 100.0 * t.colour.allowed / n), false);
   }
-  if (keep_classes_)
-    r.pixel_classes = classify_pixels(got, exact.frame, exact.ambiguity, colour_failing);
-
-  r.steps = step_stats(got.steps);
   if (external) {
     // Its steps are its own loop's count, not our kernel's: shown, not compared.
     unmeasured("steps", external->steps ? "an external renderer's steps count its own loop"
@@ -412,26 +435,10 @@ CaseResult Suite::run(const Backend& backend, const Scene& scene, const MarchPar
     judge(r, unpushed_ambiguity(r, scene, width, height));
     return r;
   }
-  const Frame& ref = reference(scene, params, width, height);
-  r.reference_steps = step_stats(ref.steps);
-  r.steps_ks = ks_statistic(got.steps, ref.steps);
   add_check(r, "steps.ks", r.steps_ks, t.steps_ks_max, false);
   const double ratio = r.reference_steps.mean > 0.0 ? r.steps.mean / r.reference_steps.mean : 1.0;
   add_check(r, "steps.mean_ratio", std::max(ratio, 1.0 / std::max(ratio, 1e-9)),
             t.steps_mean_ratio_max, false);
-
-  int diverged = 0;
-  double trace_error = 0.0;
-  for (const auto& [ray, want] : probes(scene, t.probe_rays, t.trace_events, params.max_distance)) {
-    const Trace trace = backend.trace(scene, ray, params, t.trace_events);
-    TraceComparison c = compare_traces(scene, trace, want, params.eps);
-    if (c.failure) {
-      ++diverged;
-      ++r.trace_failures[static_cast<size_t>(*c.failure)];
-    }
-    trace_error = std::max({trace_error, c.max_t_error, c.max_position_error});
-    r.traces.push_back(std::move(c));
-  }
   add_check(r, "traces.diverged", diverged, t.trace_failures_max, false);
   add_check(r, "traces.error", trace_error / scene.scale, t.trace_error, false);
   if (static_cast<int>(r.traces.size()) < t.probe_rays)
