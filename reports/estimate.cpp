@@ -122,18 +122,21 @@ std::vector<std::pair<std::string, double>> back_to_back(
       return "";
     return g.group;
   };
-  std::map<std::string, std::vector<Case>> runs;  // each backend's cases, in their order
+  // Each backend's cases after its first, in their order.
+  std::map<std::string, std::vector<Case>> later;
+  std::map<std::string, int> seen;
   for (const Case& c : order)
-    if (const std::string b = together(c); !b.empty()) runs[b].push_back(c);
+    if (const std::string b = together(c); !b.empty() && seen[b]++ > 0) later[b].push_back(c);
   std::vector<Case> out;
   out.reserve(order.size());
+  seen.clear();
   for (const Case& c : order) {
     const std::string b = together(c);
-    if (b.empty()) {
+    if (b.empty() || seen[b]++ == 0) {
       out.push_back(c);
-    } else if (auto run = runs.find(b); run != runs.end()) {  // its first case: all of them
+    } else if (auto run = later.find(b); run != later.end()) {  // its second: all the later ones
       out.insert(out.end(), run->second.begin(), run->second.end());
-      runs.erase(run);
+      later.erase(run);
     }
   }
   return out;

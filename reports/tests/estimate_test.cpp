@@ -77,17 +77,18 @@ TEST(CalibratingOrder, RunsASubgroupsScenesBitReversedEachSubgroupTurnedItsShare
                                 "matrix/a/x/s3", "matrix/a/y/s0"}));
 }
 
-TEST(BackToBack, RunsABackendsMatrixCasesWhereItsFirstFallsTheRestInTheirOrder) {
-  const Cases order = {{"compile/w/sphere/1", 1}, {"matrix/a/x/1", 2},  {"matrix/w/x/1", 3},
-                       {"matrix/a/x/2", 4},       {"matrix/w/y/2", 5},  {"matrix/a/y/1", 6},
-                       {"matrix/w/x/3", 7},       {"sweep/t/sphere", 8}};
+TEST(BackToBack, RunsABackendsLaterMatrixCasesWhereItsSecondFalls) {
+  const Cases order = {{"compile/w/sphere/1", 1}, {"matrix/a/x/1", 2}, {"matrix/w/x/1", 3},
+                       {"matrix/a/x/2", 4},       {"matrix/w/y/2", 5}, {"matrix/a/y/1", 6},
+                       {"matrix/w/x/3", 7},       {"matrix/w/y/4", 8}, {"sweep/t/sphere", 9}};
   const Cases moved = back_to_back(order, {"w"});
-  // w's compile case is not the matrix's: it stays; its matrix cases follow its first.
+  // w's compile case is not the matrix's: it stays; its first matrix case stays, the others
+  // follow one another from where the second was.
   EXPECT_EQ(keys_of(moved),
             (std::vector<std::string>{"compile/w/sphere/1", "matrix/a/x/1", "matrix/w/x/1",
-                                      "matrix/w/y/2", "matrix/w/x/3", "matrix/a/x/2",
-                                      "matrix/a/y/1", "sweep/t/sphere"}));
-  EXPECT_EQ(moved[3].second, 5);  // costs go with their keys
+                                      "matrix/a/x/2", "matrix/w/y/2", "matrix/w/x/3",
+                                      "matrix/w/y/4", "matrix/a/y/1", "sweep/t/sphere"}));
+  EXPECT_EQ(moved[5].second, 7);  // costs go with their keys
   // No backend named, or one with no case: the order as it was.
   EXPECT_EQ(keys_of(back_to_back(order, {})), keys_of(order));
   EXPECT_EQ(keys_of(back_to_back(order, {"b"})), keys_of(order));
