@@ -491,13 +491,14 @@ void add_report(CLI::App& app) {
         {"repetitions", r.sweep.repetitions}};
     if (plan) run.options["shard"] = plan->record;
     // Run so that every backend's cases are timed early (the estimates are calibrated on them),
-    // those of a backend that runs them back to back one after another from where its first
-    // falls; put together in the run's order all the same.
+    // those of a backend that runs them back to back one after another from where its second
+    // falls, the oracle's share priced on the first case of a scene and method; put together in
+    // the run's order all the same.
     std::vector<std::pair<std::string, double>> held;
     for (const auto& c : all)
       if (!plan || plan->holds(c.first)) held.push_back(c);
-    const std::vector<std::pair<std::string, double>> order =
-        reports::back_to_back(reports::calibrating_order(held), together);
+    const std::vector<std::pair<std::string, double>> order = reports::oracle_once(
+        reports::back_to_back(reports::calibrating_order(held), together), scenes, r.matrix);
     for (const auto& [key, cost] : order) run.cases.push_back({key, cost});
     for (const json& skip : skipped)
       if (!o->quiet)

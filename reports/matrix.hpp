@@ -113,6 +113,16 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
                                                          const MatrixOptions& options,
                                                          const MatrixBackends* built = nullptr);
 
+// `order` (cases of a run, in the order they run) with the part of each matrix case's oracle
+// share (oracle_case_cost) that a worker's suite keeps for the next backend's case of the scene and
+// method (its truth and steps reference) priced on the first case of them alone. Priced on every
+// case, a first report's first cases took about a fifth of their time in it and the later ones
+// almost none, and the estimate stayed 15-25% over through the matrix. A case priced below that
+// part (one only said to be skipped) neither pays it nor is the first.
+std::vector<std::pair<std::string, double>> oracle_once(
+    const std::vector<std::pair<std::string, double>>& order, const std::vector<Scene>& scenes,
+    const MatrixOptions& o);
+
 // Runs the matrix (on `backends`, or on matrix_backends(options) where null). Returns
 // {"benchmarks": Google Benchmark's JSON document (each GPU case's run labelled with its device),
 // "cases": one per backend x scene x method with its timing (median and samples, ms), counters,

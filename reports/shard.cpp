@@ -79,13 +79,18 @@ double scene_cost_factor(const Scene& scene) {
   return surface_type(scene) == "prism" ? 5.0 : 1.0;
 }
 
+double oracle_case_cost(int edges, int width, int height) {
+  // About 0.1 s at 160x90, more with more edges.
+  const double frame = static_cast<double>(width) * static_cast<double>(height) / 14400.0;
+  return 0.1 * frame * (1.0 + 0.02 * edges);
+}
+
 double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
                              int width, int height) {
-  // The oracle's truth, traces and mask, about 0.1 s at 160x90, more with more edges; then the
-  // backend's frames; a browser's page costs half a second more to open and compile.
-  const double frame = static_cast<double>(width) * static_cast<double>(height) / 14400.0;
-  const double truth = 0.1 * frame * (1.0 + 0.02 * edges);
-  return truth + cost_of(backend).startup_seconds + frame_cost(backend, method, width, height);
+  // The oracle's share; then the backend's frames; a browser's page costs half a second more to
+  // open and compile.
+  return oracle_case_cost(edges, width, height) + cost_of(backend).startup_seconds +
+         frame_cost(backend, method, width, height);
 }
 
 json shard_record(const Shard& shard, const std::vector<std::string>& cases,

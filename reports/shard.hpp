@@ -30,10 +30,13 @@ std::optional<Shard> parse_shard(const std::string& text);
 std::vector<int> assign_shards(const std::vector<double>& costs, int count);
 
 // The expected seconds of a conformance case on a 2-core machine like this one: the oracle's
-// share, the method's steps on the backend, a browser's page. The split's balance depends on it,
-// and the estimate a shard prints before it starts.
+// share (oracle_case_cost), the method's steps on the backend, a browser's page. The split's
+// balance depends on it, and the estimate a shard prints before it starts.
 double conformance_case_cost(const std::string& backend, const std::string& method, int edges,
                              int width, int height);
+// The oracle's share of a conformance case: the truth, the steps reference and the probe rays'
+// traces of its scene and method at WxH, which a suite keeps for the next backend's case of them.
+double oracle_case_cost(int edges, int width, int height);
 
 // The expected seconds of one frame of WxH by `backend` and `method` on this machine (sphere and
 // relaxed march about ten times the analytic method's steps).

@@ -17,6 +17,7 @@
 #include "reports/gallery.hpp"
 #include "reports/matrix.hpp"
 #include "reports/report.hpp"
+#include "reports/shard.hpp"
 #include "reports/work_count.hpp"
 #include "scene/load.hpp"
 #include "scene/surfaces.hpp"
@@ -30,6 +31,33 @@ namespace fs = std::filesystem;
 
 Scene gallery(const std::string& name) {
   return load_scene(fs::path(FLATMARCH_SOURCE_DIR) / "scenes" / (name + ".json"));
+}
+
+TEST(OracleOnce, LeavesTheOraclesShareOnTheFirstCaseOfEachSceneAndMethod) {
+  const std::vector<Scene> scenes = {gallery("torus"), gallery("torus_prism")};
+  MatrixOptions o;
+  o.conform_width = 160;
+  o.conform_height = 90;
+  // Half the oracle's share is kept: the torus has 4 edges, 0.5 x 0.1 x (1 + 0.02 x 4) s; the
+  // prism five times its own (scene_cost_factor).
+  const double torus = 0.5 * 0.1 * 1.08,
+               prism = 0.5 * 5.0 * oracle_case_cost(edge_count(scenes[1]), 160, 90);
+  const std::vector<std::pair<std::string, double>> order = {
+      {"matrix/a/sphere/torus", 1.0},        {"matrix/b/sphere/torus", 1.0},
+      {"matrix/b/analytic/torus", 1.0},      {"matrix/a/sphere/torus_prism", 9.0},
+      {"matrix/x/sphere/torus_prism", 0.01},  // said to be skipped: priced below the share
+      {"sweep/translation/sphere", 2.0},     {"matrix/b/sphere/torus_prism", 9.0},
+      {"matrix/b/analytic/torus", 1.0}};
+  const std::vector<std::pair<std::string, double>> priced = oracle_once(order, scenes, o);
+  ASSERT_EQ(priced.size(), order.size());
+  const std::vector<double> want = {1.0,  1.0 - torus, 1.0,         9.0,
+                                    0.01, 2.0,         9.0 - prism, 1.0 - torus};
+  for (size_t k = 0; k < want.size(); ++k) {
+    EXPECT_EQ(priced[k].first, order[k].first);
+    EXPECT_NEAR(priced[k].second, want[k], 1e-12) << priced[k].first;
+  }
+  o.conformance = false;  // no conformance case: nothing to share
+  EXPECT_EQ(oracle_once(order, scenes, o), order);
 }
 
 TEST(SurfaceType, ClassifiesTheGalleryByItsHazards) {
