@@ -487,10 +487,10 @@ std::vector<std::pair<std::string, double>> matrix_cases(const std::vector<Scene
 }
 
 // The share of oracle_case_cost that a suite keeps for the next case of the scene and method.
-// Fitted on five first reports' progress logs of a 2-vCPU Intel Xeon (Emerald Rapids), replayed
-// through StageEstimate: the matrix's worst error after its first tenth 22.5, 20.1, 11.8 and 7.7%
-// in four runs of today's order with half, against 36.4, 13.7, 18.3 and 16.1% with none kept and
-// 8.5, 27.2, 19.0 and 16.9% with all of it.
+// Fitted on four first reports' progress logs of a 2-vCPU Intel Xeon (Emerald Rapids) in today's
+// order, replayed through StageEstimate: the matrix's worst error after its first tenth 22.5,
+// 20.1, 11.8 and 7.7% with half, against 36.4, 13.7, 18.3 and 16.1% with none kept and 8.5, 27.2,
+// 19.0 and 16.9% with all of it.
 constexpr double kOracleKept = 0.5;
 
 std::vector<std::pair<std::string, double>> oracle_once(
