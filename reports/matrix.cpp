@@ -144,8 +144,9 @@ void register_frame_benchmark(const Backend& backend, const Scene& scene, const 
   // 0.05 s, and over 0.1 s where min_time is 0 (Google Benchmark's own, 0.5 s unless its flag
   // says otherwise: backend_bench). Each repetition's took a counted frame and 0.05 s of
   // stepping: the regression gate 133 s -> 118 s measured once instead. The report's peak was
-  // 0.1 s: 0.05 s, with three frames on one thread rather than four, took the SIMD cases' lane
-  // figures from 15.7 s to 10.2 s of a first report (2-vCPU Intel Xeon, Emerald Rapids).
+  // 0.1 s (with four frames on one thread, three timed): 0.05 s and three frames took the SIMD
+  // cases' lane figures from 15.7 s to 10.2 s of a first report (2-vCPU Intel Xeon, Emerald
+  // Rapids); the untimed one-thread frame is back (SimdBackend::lane_figures).
   const double peak_seconds = min_time > 0.0 ? 0.05 : 0.1;
   struct Lanes {
     bool known = false;

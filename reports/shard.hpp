@@ -46,7 +46,7 @@ double frame_cost(const std::string& backend, const std::string& method, int wid
 // in matrix.hpp): two untimed frames (the whole frame, then its colour alone: what compiles a GPU
 // backend's programs); then each of `repetitions` is one frame when a frame takes longer than
 // `min_time`, else the runs Google Benchmark makes on its way up to min_time, about 1.6 x
-// min_time in all. The SIMD backend adds its counted frame, its lane peak (0.05 s) and three
+// min_time in all. The SIMD backend adds its counted frame, its lane peak (0.05 s) and four
 // frames on one thread.
 double timed_case_cost(const std::string& backend, double frame_seconds, int repetitions,
                        double min_time);

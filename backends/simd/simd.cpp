@@ -244,6 +244,11 @@ std::optional<LaneFigures> SimdBackend::lane_figures(const Scene& scene, const C
   options.isa = isa();
   options.threads = 1;
   const SimdBackend one(options);
+  // One untimed frame first: without it the one-thread figures of the same cases moved by
+  // 0.57-1.63x between builds in single runs on every instruction set (2-vCPU Intel Xeon, Emerald
+  // Rapids; geometric means 0.94 / 0.83 / 0.99 on AVX-512 / AVX2 / SSE4), which no run there could
+  // tell from the VM's drift.
+  one.render_colour(scene, camera, width, height, params, {});
   std::array<double, 3> seconds{};
   for (double& s : seconds) {
     const auto start = std::chrono::steady_clock::now();
