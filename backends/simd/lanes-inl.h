@@ -181,7 +181,11 @@ HWY_INLINE void SetNormal(Packet& r, M m, V nx, V ny, V nz) {
 struct WallDistance {
   V d;
   VI edge;
+  // The next edge's distance, or its square where `second_squared` (nearest_edge's: a step
+  // needs it only at an edge, where next_edge() takes its root, saving a square root a step).
   V second;
+  bool second_squared = false;
+  HWY_INLINE V next_edge() const { return second_squared ? hn::Sqrt(second) : second; }
 };
 
 struct Exit {

@@ -249,7 +249,7 @@ class Marcher : private RayEvents {
     }
     const M near = hn::And(rest, wall_d < eps);
     if (Any(near)) {
-      const M corner = hn::And(near, wall.second < eps);
+      const M corner = hn::And(near, wall.next_edge() < eps);
       finish(r, corner, SplatI(kHitVertex), kEventVertex, SplatI(-1), Splat(0.0f));
       const M walls = hn::AndNot(corner, hn::And(near, walls_.is_wall(rooms, wall.edge)));
       hit_wall(r, walls, rooms, wall.edge, Splat(0.0f));

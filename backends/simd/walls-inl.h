@@ -356,7 +356,8 @@ class Walls {
     const V root = hn::Sqrt(best);
     w.d = Select(inside, root, hn::Neg(root));
     w.edge = edge;
-    w.second = hn::Sqrt(second);
+    w.second = second;
+    w.second_squared = true;
     return w;
   }
 
