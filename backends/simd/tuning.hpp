@@ -114,7 +114,9 @@ struct Tuning {
 // (Zen 5, `FLATMARCH_SIMD_TUNE` in a probe build, `bench/ab.py --pin 1`, best of 4-6 interleaved
 // rounds, NOTES.md's *Tuned per instruction set*). This VM's single-thread figures move by up to
 // 10% between runs, so a value changed only where the cases it governs moved together and the
-// cases it cannot touch stayed level.
+// cases it cannot touch stayed level. Each mode was measured against its fallback again on an Intel
+// Xeon (Emerald Rapids, 2026-12-06): each mode a row takes was level or faster there, and nothing
+// measured there beyond that VM's noise argues for another value (NOTES.md).
 //
 // | value                 | avx512 | avx2 | sse4 | set by                                       |
 // |-----------------------|--------|------|------|----------------------------------------------|
