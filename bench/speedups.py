@@ -7,6 +7,12 @@ each instruction set the run timed:
   per lane     that speed-up over the instruction set's lanes: the lane efficiency, the share of
                what these lanes could do if every lane ran the scalar backend's ray as fast
   busy         lanes busy (active lanes over lanes, summed over every pass of the frame)
+  step         the lane efficiency's first factor: the instruction set's cheapest step (the
+               central packet's one step, peak_steps_per_s) per lane, over the scalar backend's
+               steps a second (its rays/s times its steps a ray): what a step costs in lanes
+  of peak      its second factor: the share of that peak the frame keeps (simd_bench's of_peak:
+               lanes idle, refills, endings, crossings). per lane = step x of peak, since both
+               backends take the same steps.
   all cores    SIMD on all cores over the scalar backend on one
   scaling      all cores over one thread, the same instruction set
 Medians when the run has repetitions. The header names the CPU and its cores: a figure belongs to
@@ -80,6 +86,11 @@ def table(runs):
                            lanes=lanes, lanes_busy=one.get("lane_utilisation"))
                 if lanes:
                     row["lane_efficiency"] = row["speedup_one_thread"] / lanes
+                scalar_steps = scalar * b.get("steps_mean", 0)
+                if lanes and scalar_steps > 0 and one.get("peak_steps_per_s"):
+                    row["step_per_lane"] = one["peak_steps_per_s"] / lanes / scalar_steps
+                if one.get("of_peak") is not None:
+                    row["of_peak"] = one["of_peak"]
             if top:
                 row.update(threads=most, all_cores_rays_per_s=top["rays_per_s"],
                            speedup_all_cores=top["rays_per_s"] / scalar)
@@ -134,7 +145,8 @@ def main():
     print(f"host: {context.get('host_name', '?')}, CPU {cpu_model()}, {context.get('num_cpus', '?')} CPUs, "
           f"{context.get('date', '?')} (the CPU is this machine's: run this where the JSON was made)")
     print(f"{'scene':<16} {'method':<9} {'isa':<7} {'scalar':>8} {'1 thread':>9} {'speedup':>8} "
-          f"{'per lane':>8} {'busy':>5} {'all cores':>10} {'speedup':>8} {'scaling':>8}")
+          f"{'per lane':>8} {'busy':>5} {'step':>5} {'of peak':>7} {'all cores':>10} {'speedup':>8} "
+          f"{'scaling':>8}")
     failures = []
     best_isa = {}
     for r in rows:
@@ -145,6 +157,7 @@ def main():
         print(f"{r['scene']:<16} {r['method']:<9} {r['isa']:<7} {r['scalar_rays_per_s'] / 1e6:>7.3f}M "
               f"{r.get('one_thread_rays_per_s', 0) / 1e6:>8.2f}M {cell('speedup_one_thread', '.2f', 7)}x "
               f"{cell('lane_efficiency', '.3f', 8)} {cell('lanes_busy', '.2f', 5)} "
+              f"{cell('step_per_lane', '.2f', 5)} {cell('of_peak', '.2f', 7)} "
               f"{r.get('all_cores_rays_per_s', 0) / 1e6:>9.2f}M {cell('speedup_all_cores', '.1f', 7)}x "
               f"{cell('scaling', '.2f', 7)}x")
         want = args.min_efficiency.get(r["method"])
