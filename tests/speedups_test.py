@@ -75,7 +75,8 @@ def main():
     check("step" in r.stdout and "of peak" in r.stdout, "the table names the two factors")
     with open(rows_path) as f:
         rows = {row["isa"]: row for row in json.load(f)["rows"]}
-    check(sorted(rows) == ["avx2", "avx512"], f"one row per instruction set of the cube: {sorted(rows)}")
+    check(sorted(rows) == ["avx2", "avx512"],
+          f"one row per instruction set of the cube: {sorted(rows)}")
     hand = {
         "avx2": dict(speedup_one_thread=4.0, lane_efficiency=0.5, step_per_lane=1.0, of_peak=0.5,
                      scaling=1.9, lanes_busy=0.95),
