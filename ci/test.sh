@@ -72,9 +72,10 @@ run_fuzzers() {
 stage "install dependencies" ci/install-deps.sh || exit 1
 # No debug information in this build, and -O1 (as RelWithDebInfo): -g was a third of the compile
 # time and nothing here reads it; -O1 compiled this build in 966 CPU-seconds against -O2's 1274
-# (packet.cpp 97 s against 196, scalar_f32.cpp 21 against 37) and its tests ran about as long
-# (ctest 636 s against 617; the SIMD backend's cases slower, the browsers' as before), 2-core Zen
-# 5. The Release build users run (-O3, packet.cpp -O2) is not this one: docs/tests.md.
+# (packet.cpp 97 s against 196, scalar_f64.cpp 18 against 37) and its tests ran about as long
+# (ctest 625-636 s in three runs against 617; the SIMD backend's cases slower, the browsers' as
+# before), 2-core Zen 5. The Release build users run (-O3, packet.cpp -O2) is not this one:
+# docs/tests.md.
 stage "build (-Werror)" ci/build.sh build -DFLATMARCH_WERROR=ON "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -DNDEBUG" \
   && stage "ctest" run_ctest build
 # Only what `ctest -L unit` runs (the unit_tests target): the benchmark programs and the other
